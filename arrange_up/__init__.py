@@ -1,9 +1,50 @@
 """arrange-up: conformant planning for robot tabletop manipulation.
 
 Importing this package is cheap: heavy libraries (unified-planning, pymunk, matplotlib) are
-imported only by the modules that need them.
+imported only by the modules that need them. Importing it also registers arrange-up's engines
+with unified-planning (without importing unified-planning: the registration takes effect when
+unified-planning's engine factory loads), so ``OneshotPlanner(name="arrange-up")`` works in any
+program that has imported ``arrange_up``.
+
+Entry points for library users::
+
+    import arrange_up
+    problem = arrange_up.load("blocks-4")          # a shipped name, a .yaml or a .pddl path
+    result = arrange_up.plan(problem, semantics="particles", particles=50, seed=0)
+    up_problem = arrange_up.to_up(problem)          # a unified_planning.model.Problem
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
+from arrange_up.engines import register as _register_up_engines
+
 __version__ = "0.1.0"
+__all__ = ["load", "plan", "to_up", "__version__"]
+
+if TYPE_CHECKING:  # pragma: no cover
+    from arrange_up.compile import to_up
+    from arrange_up.domains import load
+    from arrange_up.planner import plan
+
+_LAZY = {
+    "load": ("arrange_up.domains", "load"),
+    "plan": ("arrange_up.planner", "plan"),
+    "to_up": ("arrange_up.compile", "to_up"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    # The public functions live in modules with heavy imports; load them on first use.
+    if name in _LAZY:
+        import importlib
+
+        module, attribute = _LAZY[name]
+        value = getattr(importlib.import_module(module), attribute)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'arrange_up' has no attribute {name!r}")
+
+
+_register_up_engines()

@@ -22,8 +22,6 @@ EXIT_OK = 0
 EXIT_NEGATIVE = 1
 EXIT_BAD_INPUT = 2
 
-PROBLEM_HELP = "A problem file (.yaml) or the name of a shipped domain (see `arrange-up domains`)."
-
 
 def _fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
     click.echo(f"arrange-up: {message}", err=True)
@@ -69,17 +67,28 @@ def main() -> None:
 @click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--quiet", "-q", is_flag=True, help="Print only errors and warnings.")
 def check(files: tuple[str, ...], quiet: bool) -> None:
-    """Validate problem FILES against the problem format.
+    """Validate problem FILES (.yaml, or .pddl of the arrange-up domain).
 
     Every problem in every file is reported at once, as FILE:LINE:COL: severity: key.path:
     message. Exits 1 if any file has errors, 0 otherwise (warnings do not fail).
     """
     from arrange_up.loader import check_problem
 
+    def check_any(file: str):
+        if Path(file).suffix.lower() != ".pddl":
+            return check_problem(file)
+        from arrange_up.errors import ProblemFormatError
+        from arrange_up.pddl import load_pddl_problem
+
+        try:
+            return load_pddl_problem(file), []
+        except ProblemFormatError as error:
+            return None, list(error.diagnostics)
+
     failed = 0
     names: dict[tuple[Path, str], str] = {}
     for file in files:
-        problem, diagnostics = check_problem(file)
+        problem, diagnostics = check_any(file)
         for diagnostic in diagnostics:
             click.echo(str(diagnostic), err=True)
         if problem is None:
@@ -112,14 +121,20 @@ def domains() -> None:
     rows = list_domains()
     width = max((len(info.name) for info in rows), default=4)
     for info in rows:
-        click.echo(f"{info.name:<{width}}  {info.parts:>2} parts  {info.goal_kind:<8}  "
-                   f"{info.summary}")
+        click.echo(
+            f"{info.name:<{width}}  {info.parts:>2} parts  {info.goal_kind:<8}  {info.summary}"
+        )
 
 
 @main.command()
 @click.argument("problem")
-@click.option("--output", "-o", type=click.Path(dir_okay=False, writable=True), required=True,
-              help="Where to write the picture (.png).")
+@click.option(
+    "--output",
+    "-o",
+    type=click.Path(dir_okay=False, writable=True),
+    required=True,
+    help="Where to write the picture (.png).",
+)
 @click.option("--dpi", type=click.IntRange(30, 600), default=150, show_default=True)
 def show(problem: str, output: str, dpi: int) -> None:
     """Draw PROBLEM: table, walls, obstacles, parts with their belief shadows, and the goal.
@@ -133,16 +148,265 @@ def show(problem: str, output: str, dpi: int) -> None:
     click.echo(f"wrote {path}")
 
 
+def _progress_printer(enabled: bool):
+    """A progress callback for long work: a live status line on a terminal, else nothing."""
+    if not enabled or not sys.stderr.isatty():
+        return None, None
+    from rich.console import Console
+    from rich.live import Live
+    from rich.text import Text
+
+    live = Live(
+        Text("starting…"), console=Console(stderr=True), refresh_per_second=5, transient=True
+    )
+    live.start()
+
+    def update(stats: dict) -> None:
+        best = stats.get("best_h")
+        live.update(
+            Text(
+                f"expanded {stats['expanded']:>6}  generated {stats['generated']:>7}  "
+                f"simulated {stats['transitions_simulated']:>8}  best h "
+                f"{'-' if best is None else f'{best:g}'}  {stats['elapsed']:6.1f} s"
+            )
+        )
+
+    return update, live
+
+
+def _actions_table(problem, actions) -> str:
+    """The plan as an aligned text table in the problem's units."""
+    from arrange_up.planfile import action_to_json
+
+    units = problem.units
+    lines = [
+        f"{'#':>3}  {'action':<6} {'object':<12} {'x':>8} {'y':>8} {'theta':>8} {'distance':>9}",
+        f"{'':>3}  {'':<6} {'':<12} {units.length:>8} {units.length:>8} "
+        f"{units.angle:>8} {units.length:>9}",
+    ]
+    for i, action in enumerate(actions, 1):
+        data = action_to_json(action, units)
+        pose = data.get("pose")
+        xs = [f"{v:8.3f}" for v in pose] if pose else [f"{'':>8}"] * 3
+        dist = f"{data['distance']:9.3f}" if "distance" in data else ""
+        who = data.get("object") or data.get("manipulator")
+        lines.append(f"{i:>3}  {data['type']:<6} {who:<12} {' '.join(xs)} {dist}")
+    return "\n".join(lines)
+
+
+@main.command()
+@click.argument("problem")
+@click.option(
+    "--semantics",
+    default="particles",
+    show_default=True,
+    help="Belief transition: deterministic (nominal, one particle, no noise) or "
+    "particles (thesis §3.1).",
+)
+@click.option(
+    "--particles",
+    type=click.IntRange(1, 100_000),
+    default=50,
+    show_default=True,
+    help="Particles per belief (particle semantics).",
+)
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="Seed for initial particles and noise: equal seeds give equal plans.",
+)
+@click.option(
+    "--max-nodes",
+    type=click.IntRange(1, None),
+    default=None,
+    help="Node limit (default: the problem's planning.max_nodes, else 5000).",
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Give up after this many seconds.",
+)
+@click.option(
+    "--heuristic",
+    default="inadmissible",
+    show_default=True,
+    type=click.Choice(["inadmissible", "admissible", "ordering", "manhattan", "blind"]),
+    help="Search heuristic (thesis §2.2.2, §3.2).",
+)
+@click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
+@click.option(
+    "--workers",
+    type=click.IntRange(1, 256),
+    default=None,
+    help="Processes simulating particles (default: all cores; 1 for deterministic).",
+)
+@click.option(
+    "--output",
+    "-o",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write the plan file (JSON, documented in docs/plan-format.md).",
+)
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print a machine-readable summary (JSON) on stdout instead of the table.",
+)
+def plan(
+    problem: str,
+    semantics: str,
+    particles: int,
+    seed: int,
+    max_nodes: int | None,
+    timeout: float | None,
+    heuristic: str,
+    no_dominance: bool,
+    workers: int | None,
+    output: str | None,
+    as_json: bool,
+) -> None:
+    """Search belief space for a conformant plan for PROBLEM.
+
+    \b
+    Examples:
+      arrange-up plan blocks-2 --semantics deterministic
+      arrange-up plan blocks-4 --particles 50 --seed 1 --output blocks-4.plan.json
+      arrange-up plan my-problem.yaml --timeout 300 --json
+
+    Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted),
+    2 bad input.
+    """
+    import json
+
+    from arrange_up.planfile import plan_document, write_json_atomic
+    from arrange_up.planner import plan as run_plan
+    from arrange_up.transitions import available
+
+    if semantics not in available():
+        _fail(
+            f"--semantics: unknown semantics {semantics!r}; expected one of "
+            f"{', '.join(available())}"
+        )
+    loaded = _load(problem)
+    if workers is None:
+        from arrange_up.transitions.particles import default_workers
+
+        workers = 1 if semantics == "deterministic" else default_workers()
+    update, live = _progress_printer(True)
+    try:
+        result = run_plan(
+            loaded,
+            semantics=semantics,
+            particles=particles,
+            seed=seed,
+            max_nodes=max_nodes,
+            timeout=timeout,
+            heuristic=heuristic,
+            dominance=not no_dominance,
+            workers=workers,
+            progress=update,
+        )
+    except KeyboardInterrupt:
+        _fail("interrupted; no plan was written", EXIT_NEGATIVE)
+    finally:
+        if live is not None:
+            live.stop()
+    extra = {"particles": result.particles}
+    document = plan_document(
+        loaded,
+        result.actions,
+        status=result.status,
+        semantics=result.semantics,
+        seed=seed,
+        search=result.stats,
+        extra=extra,
+    )
+    if output:
+        write_json_atomic(Path(output), document)
+    if as_json:
+        summary = {k: v for k, v in document.items() if k != "actions"}
+        summary["plan_length"] = len(result.actions) if result.actions is not None else None
+        summary["actions"] = document.get("actions")
+        summary["output"] = output
+        click.echo(json.dumps(summary, indent=2))
+    else:
+        stats = result.stats
+        click.echo(
+            f"{loaded.name}: {result.status} ({result.semantics}, "
+            f"{result.particles} particle{'s' if result.particles != 1 else ''}, "
+            f"seed {seed}) in {stats['elapsed']:.1f} s: expanded {stats['expanded']}, "
+            f"generated {stats['generated']}, "
+            f"transitions simulated {stats['transitions_simulated']}"
+        )
+        if result.actions is not None:
+            click.echo(_actions_table(loaded, result.actions))
+        if output:
+            click.echo(f"wrote {output}")
+    if not result.solved:
+        sys.exit(EXIT_NEGATIVE)
+
+
+@main.command()
+@click.argument("problem")
+@click.option(
+    "--to",
+    "fmt",
+    type=click.Choice(["pddl"]),
+    default="pddl",
+    show_default=True,
+    help="Target format.",
+)
+@click.option(
+    "--output",
+    "-o",
+    type=click.Path(dir_okay=False, writable=True),
+    required=True,
+    help="Where to write the problem.",
+)
+def export(problem: str, fmt: str, output: str) -> None:
+    """Write PROBLEM as a PDDL 2.1 problem of the arrange-up domain (inches, degrees).
+
+    The domain it refers to ships in semantics/arrange-up-domain.pddl. What PDDL cannot
+    express (shapes outside the shape catalogue, planning hints, ...) is refused with every
+    reason listed, and nothing is written (exit status 1).
+    """
+    from arrange_up.pddl import PddlExportError, write_pddl_problem
+
+    loaded = _load(problem)
+    try:
+        text = write_pddl_problem(loaded)
+    except PddlExportError as error:
+        _fail(str(error), EXIT_NEGATIVE)
+    from arrange_up.planfile import write_text_atomic
+
+    write_text_atomic(Path(output), text)
+    click.echo(f"wrote {output}")
+
+
 @main.group()
 def bench() -> None:
     """Measure the speed of the building blocks (figures printed, nothing written)."""
 
 
 @bench.command("physics")
-@click.option("--pushes", type=click.IntRange(10, 1_000_000), default=300, show_default=True,
-              help="Pushes simulated per scene and worker count.")
-@click.option("--workers", type=str, default="1,2", show_default=True,
-              help="Comma-separated process counts to measure.")
+@click.option(
+    "--pushes",
+    type=click.IntRange(10, 1_000_000),
+    default=300,
+    show_default=True,
+    help="Pushes simulated per scene and worker count.",
+)
+@click.option(
+    "--workers",
+    type=str,
+    default="1,2",
+    show_default=True,
+    help="Comma-separated process counts to measure.",
+)
 @click.option("--seed", type=int, default=0, show_default=True)
 def bench_physics_command(pushes: int, workers: str, seed: int) -> None:
     """Push rollouts per second: 1 block, a 3-block and a 7-block chain against a wall.
@@ -157,14 +421,19 @@ def bench_physics_command(pushes: int, workers: str, seed: int) -> None:
         _fail("--workers: counts must be at least 1")
     from arrange_up.bench import bench_physics
 
-    rows = bench_physics(n_pushes=pushes, workers=counts, seed=seed,
-                         progress=lambda msg: click.echo(msg, err=True))
-    click.echo(f"{'scene':<16} {'workers':>7} {'pushes':>7} {'seconds':>8} {'pushes/s':>9} "
-               f"{'ms/push':>8} {'not at rest':>11}")
+    rows = bench_physics(
+        n_pushes=pushes, workers=counts, seed=seed, progress=lambda msg: click.echo(msg, err=True)
+    )
+    click.echo(
+        f"{'scene':<16} {'workers':>7} {'pushes':>7} {'seconds':>8} {'pushes/s':>9} "
+        f"{'ms/push':>8} {'not at rest':>11}"
+    )
     for row in rows:
-        click.echo(f"{row['scene']:<16} {row['workers']:>7} {row['pushes']:>7} "
-                   f"{row['seconds']:>8.2f} {row['pushes_per_second']:>9.0f} "
-                   f"{row['ms_per_push']:>8.2f} {row['not_at_rest']:>11}")
+        click.echo(
+            f"{row['scene']:<16} {row['workers']:>7} {row['pushes']:>7} "
+            f"{row['seconds']:>8.2f} {row['pushes_per_second']:>9.0f} "
+            f"{row['ms_per_push']:>8.2f} {row['not_at_rest']:>11}"
+        )
 
 
 if __name__ == "__main__":  # pragma: no cover

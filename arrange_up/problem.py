@@ -38,7 +38,7 @@ ConvexPolygon = tuple[Point, ...]
 WALL_EDGES: tuple[str, ...] = ("left", "right", "bottom", "top")
 
 
-class ObjectKind(str, enum.Enum):
+class ObjectKind(enum.StrEnum):
     """The role an object plays (thesis §1.2.1): parts are arranged, manipulators push,
     fixtures are movable obstacles the planner may place and pick, obstacles never move."""
 
@@ -245,3 +245,35 @@ class ArrangementProblem:
     @property
     def obstacles(self) -> tuple[ObjectSpec, ...]:
         return self.of_kind(ObjectKind.OBSTACLE)
+
+
+def problem_hash(problem: ArrangementProblem) -> str:
+    """A content hash of what the planner sees: ``"sha256:<hex>"``.
+
+    It covers the name, table, objects, initial belief, goal, uncertainty and planning hints in
+    internal units, with numbers rounded to 9 significant digits, so the same problem written in
+    other units or in another format (``.yaml`` or ``.pddl``) hashes the same. The description,
+    the file's units and its location are not part of the content.
+    """
+    import dataclasses
+    import hashlib
+    import json
+
+    def canonical(value: object) -> object:
+        if dataclasses.is_dataclass(value) and not isinstance(value, type):
+            return {
+                f.name: canonical(getattr(value, f.name))
+                for f in dataclasses.fields(value)
+                if f.name not in ("description", "units", "source")
+            }
+        if isinstance(value, enum.Enum):
+            return value.value
+        if isinstance(value, tuple | list):
+            return [canonical(v) for v in value]
+        if isinstance(value, float):
+            rounded = float(f"{value:.9g}")
+            return 0.0 if rounded == 0 else rounded
+        return value
+
+    text = json.dumps(canonical(problem), sort_keys=True, separators=(",", ":"))
+    return "sha256:" + hashlib.sha256(text.encode("utf-8")).hexdigest()

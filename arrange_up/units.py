@@ -28,11 +28,13 @@ class Units:
 
     def __post_init__(self) -> None:
         if self.length not in LENGTH_UNITS:
-            raise ValueError(f"unknown length unit {self.length!r}; expected one of "
-                             f"{', '.join(LENGTH_UNITS)}")
+            raise ValueError(
+                f"unknown length unit {self.length!r}; expected one of {', '.join(LENGTH_UNITS)}"
+            )
         if self.angle not in ANGLE_UNITS:
-            raise ValueError(f"unknown angle unit {self.angle!r}; expected one of "
-                             f"{', '.join(ANGLE_UNITS)}")
+            raise ValueError(
+                f"unknown angle unit {self.angle!r}; expected one of {', '.join(ANGLE_UNITS)}"
+            )
 
     @property
     def length_factor(self) -> float:

@@ -108,7 +108,9 @@ def _uniform_offset(rng: np.random.Generator, half: HalfWidths) -> HalfWidths:
     return (float(u[0] * half[0]), float(u[1] * half[1]), float(u[2] * half[2]))
 
 
-def draw_noise(problem: ArrangementProblem, action: Action, rng: np.random.Generator) -> ActionNoise:
+def draw_noise(
+    problem: ArrangementProblem, action: Action, rng: np.random.Generator
+) -> ActionNoise:
     """Draw the noise of one action from the problem's uncertainty, uniformly.
 
     Always consumes the same number of random values whatever the action, so a rollout's

@@ -1,0 +1,384 @@
+"""arrange-up's planner as a unified-planning engine: ``OneshotPlanner(name="arrange-up")``.
+
+    >>> from unified_planning.shortcuts import OneshotPlanner
+    >>> from arrange_up.compile import to_up
+    >>> from arrange_up.domains import load
+    >>> problem = to_up(load("blocks-1"))
+    >>> with OneshotPlanner(name="arrange-up", params={"semantics": "deterministic"}) as p:
+    ...     result = p.solve(problem, timeout=60)
+    >>> result.status.name
+    'SOLVED_SATISFICING'
+
+The engine converts the UP problem back to an
+:class:`~arrange_up.problem.ArrangementProblem` (:func:`arrange_up.compile.from_up`: problems
+made by :func:`~arrange_up.compile.to_up`, and problems read by ``PDDLReader`` from
+arrange-up's PDDL domain), runs :func:`arrange_up.planner.plan` and returns a
+``PlanGenerationResult`` with an honest status:
+
+* ``SOLVED_SATISFICING``: a ``SequentialPlan`` of ``place``/``push``/``pick`` instances with
+  exact ``Fraction`` real parameters (inches, degrees). For a problem read from PDDL, whose
+  actions cannot carry real parameters, the instances belong to ``to_up`` of the same problem
+  (a log message says so).
+* ``UNSOLVABLE_INCOMPLETELY``: the node limit was reached, or the search space was exhausted
+  under pruning (the search is incomplete, so nothing is proven).
+* ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
+  watches the clock itself.
+* ``UNSUPPORTED_PROBLEM``: the problem is not an arrange-up problem; ``INTERNAL_ERROR``: the
+  planner failed. Both with a log message saying why.
+
+Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` (default
+``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000).
+Metrics hold the search statistics (expanded, generated, evaluated, pruned, elapsed, ...).
+
+**Registration** (:func:`register`). unified-planning finds engines only through its factory.
+Importing UP's engine machinery costs ~1.5 s (ConfigSpace, scipy), so :func:`register` never
+imports it: if UP's factory is already loaded it registers at once (idempotently), otherwise it
+installs an import hook that adds the engine to UP's default engine table as soon as UP loads
+its factory. Importing this module is as cheap; the engine class itself
+(:class:`ArrangeUpPlanner`) is built, importing UP, the first time it is asked for.
+"""
+
+from __future__ import annotations
+
+import sys
+
+# Only ``sys`` at import time: this module is imported when arrange-up is, and must stay cheap
+# (``typing``, ``functools`` and ``warnings`` alone add ~10 ms to a bare interpreter).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any
+
+# ArrangeUpPlanner is also public; it is built on first access (see ``__getattr__``)
+__all__ = ["ENGINE_CLASS", "ENGINE_NAME", "register"]
+
+ENGINE_NAME = "arrange-up"
+ENGINE_CLASS = "ArrangeUpPlanner"
+_FACTORY_MODULE = "unified_planning.engines.factory"
+
+
+# ---------------------------------------------------------------------------------------------
+# registration (standard library only)
+# ---------------------------------------------------------------------------------------------
+def register(environment: Any = None) -> None:
+    """Make the ``arrange-up`` engine known to unified-planning; cheap and idempotent.
+
+    * UP's factory module already imported: add the engine to its default engine table (for
+      environments created later) and to the factory of ``environment`` or of UP's global
+      environment if it exists.
+    * Otherwise: install an import hook that adds the engine to the default table when UP
+      imports its factory, so the global environment has it from the start. Nothing of UP is
+      imported here.
+    """
+    module = sys.modules.get(_FACTORY_MODULE)
+    if module is None and environment is None:
+        if not any(isinstance(finder, _FactoryHook) for finder in sys.meta_path):
+            sys.meta_path.insert(0, _FactoryHook())
+        return
+    if module is not None:
+        _add_to_defaults(module)
+    if environment is None:
+        env_module = sys.modules.get("unified_planning.environment")
+        environment = getattr(env_module, "GLOBAL_ENVIRONMENT", None)
+    if environment is not None and ENGINE_NAME not in environment.factory.engines:
+        environment.factory.add_engine(ENGINE_NAME, __name__, ENGINE_CLASS)
+
+
+def _add_to_defaults(factory_module: Any) -> None:
+    defaults = getattr(factory_module, "DEFAULT_ENGINES", None)
+    if isinstance(defaults, dict):
+        defaults.setdefault(ENGINE_NAME, (__name__, ENGINE_CLASS))
+    preference = getattr(factory_module, "DEFAULT_ENGINES_PREFERENCE_LIST", None)
+    if isinstance(preference, list) and ENGINE_NAME not in preference:
+        preference.append(ENGINE_NAME)
+
+
+class _FactoryHook:
+    """A meta path finder that finds nothing itself; it wraps the loader of UP's factory module
+    so that :func:`_add_to_defaults` runs right after the module is executed. (Not derived from
+    ``importlib.abc`` classes: importing ``importlib.abc`` alone costs ~20 ms.)"""
+
+    def find_spec(self, fullname: str, path: Any, target: Any = None) -> Any:
+        if fullname != _FACTORY_MODULE:
+            return None
+        for finder in sys.meta_path:
+            if finder is self or not hasattr(finder, "find_spec"):
+                continue
+            spec = finder.find_spec(fullname, path, target)
+            if spec is not None:
+                break
+        else:
+            return None
+        if spec.loader is not None and hasattr(spec.loader, "exec_module"):
+            spec.loader = _PatchingLoader(spec.loader, self)
+        return spec
+
+
+class _PatchingLoader:
+    def __init__(self, loader: Any, hook: _FactoryHook) -> None:
+        self._loader = loader
+        self._hook = hook
+
+    def create_module(self, spec: Any) -> Any:
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module: Any) -> None:
+        self._loader.exec_module(module)
+        if self._hook in sys.meta_path:
+            sys.meta_path.remove(self._hook)
+        _add_to_defaults(module)
+
+    def __getattr__(self, name: str) -> Any:  # get_source, get_filename, ... of the real loader
+        return getattr(self._loader, name)
+
+
+def __getattr__(name: str) -> Any:  # PEP 562: the engine class is built on first use
+    if name == ENGINE_CLASS:
+        return _engine_class()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+# ---------------------------------------------------------------------------------------------
+# the engine (imports unified-planning)
+# ---------------------------------------------------------------------------------------------
+_CACHE: dict[str, Any] = {}
+
+
+def _engine_class() -> type:
+    if "engine" not in _CACHE:
+        _CACHE["engine"] = _build_engine_class()
+    return _CACHE["engine"]
+
+
+def _build_engine_class() -> type:
+    import warnings
+
+    from unified_planning.engines import Engine
+    from unified_planning.engines.mixins import OneshotPlannerMixin
+
+    class ArrangeUpPlanner(Engine, OneshotPlannerMixin):
+        """Conformant belief-space planning for arrange-up problems (see the module doc)."""
+
+        def __init__(
+            self,
+            semantics: str = "particles",
+            particles: int = 50,
+            seed: int = 0,
+            max_nodes: int | None = None,
+        ) -> None:
+            Engine.__init__(self)
+            OneshotPlannerMixin.__init__(self)
+            _check_params(semantics, particles, seed, max_nodes)
+            self._semantics = semantics
+            self._particles = particles
+            self._seed = seed
+            self._max_nodes = max_nodes
+
+        @property
+        def name(self) -> str:
+            return ENGINE_NAME
+
+        @staticmethod
+        def supported_kind() -> Any:
+            return _supported_kind()
+
+        @staticmethod
+        def supports(problem_kind: Any) -> bool:
+            return bool(problem_kind <= _supported_kind())
+
+        def _solve_with_params(
+            self,
+            problem: Any,
+            heuristic: Any = None,
+            timeout: float | None = None,
+            output_stream: Any = None,
+            warm_start_plan: Any = None,
+            **kwargs: Any,
+        ) -> Any:
+            if warm_start_plan is not None:
+                warnings.warn("arrange-up ignores warm_start_plan", UserWarning, stacklevel=3)
+            if kwargs:
+                warnings.warn(
+                    f"arrange-up ignores the solve() arguments {', '.join(sorted(kwargs))}; "
+                    "give engine parameters through OneshotPlanner(params={...})",
+                    UserWarning,
+                    stacklevel=3,
+                )
+            return self._solve(problem, heuristic, timeout, output_stream)
+
+        def _solve(
+            self,
+            problem: Any,
+            heuristic: Any = None,
+            timeout: float | None = None,
+            output_stream: Any = None,
+        ) -> Any:
+            return _solve(self, problem, heuristic, timeout, output_stream)
+
+    ArrangeUpPlanner.__module__ = __name__
+    ArrangeUpPlanner.__qualname__ = ENGINE_CLASS  # picklable as arrange_up.engines.ArrangeUpPlanner
+    return ArrangeUpPlanner
+
+
+def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any) -> None:
+    from arrange_up.transitions import available
+
+    if semantics not in available():
+        raise ValueError(
+            f"arrange-up: unknown semantics {semantics!r}; expected one of {', '.join(available())}"
+        )
+    if not isinstance(particles, int) or isinstance(particles, bool) or particles < 1:
+        raise ValueError(f"arrange-up: particles must be a positive integer, got {particles!r}")
+    if not isinstance(seed, int) or isinstance(seed, bool):
+        raise ValueError(f"arrange-up: seed must be an integer, got {seed!r}")
+    if max_nodes is not None and (
+        not isinstance(max_nodes, int) or isinstance(max_nodes, bool) or max_nodes < 1
+    ):
+        raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
+
+
+def _supported_kind() -> Any:
+    if "kind" in _CACHE:
+        return _CACHE["kind"]
+    from unified_planning.model import ProblemKind
+
+    kind = ProblemKind(version=2)
+    kind.set_problem_class("ACTION_BASED")
+    kind.set_problem_type("SIMPLE_NUMERIC_PLANNING")
+    kind.set_typing("FLAT_TYPING")
+    kind.set_typing("HIERARCHICAL_TYPING")
+    kind.set_conditions_kind("NEGATIVE_CONDITIONS")
+    kind.set_conditions_kind("EQUALITIES")
+    kind.set_parameters("REAL_ACTION_PARAMETERS")
+    kind.set_fluents_type("REAL_FLUENTS")
+    kind.set_simulated_entities("SIMULATED_EFFECTS")
+    kind.set_initial_state("UNDEFINED_INITIAL_NUMERIC")
+    _CACHE["kind"] = kind
+    return kind
+
+
+def _solve(engine: Any, problem: Any, heuristic: Any, timeout: float | None, stream: Any) -> Any:
+    import time
+    import warnings
+
+    from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
+    from unified_planning.engines import PlanGenerationResultStatus as Status
+
+    from arrange_up import planner
+    from arrange_up.compile import from_up, made_by_to_up, plan_to_up, to_up
+
+    started = time.monotonic()
+    if heuristic is not None:
+        warnings.warn(
+            "arrange-up ignores the heuristic argument: it searches belief space with its own "
+            "heuristics",
+            UserWarning,
+            stacklevel=4,
+        )
+
+    def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
+        return PlanGenerationResult(
+            status, plan, ENGINE_NAME, metrics=metrics, log_messages=list(logs) or None
+        )
+
+    try:
+        arrangement = from_up(problem)
+    except ValueError as error:  # ProblemFormatError is a ValueError
+        return result(
+            Status.UNSUPPORTED_PROBLEM,
+            logs=[LogMessage(LogLevel.ERROR, f"not an arrange-up problem: {error}")],
+        )
+
+    deadline = None if timeout is None else started + max(0.0, float(timeout))
+
+    def out_of_time() -> bool:
+        return deadline is not None and time.monotonic() >= deadline
+
+    def progress(stats: dict[str, Any]) -> None:
+        if stream is not None:
+            stream.write(
+                "arrange-up: " + " ".join(f"{k}={_short(v)}" for k, v in stats.items()) + "\n"
+            )
+
+    try:
+        outcome = planner.plan(
+            arrangement,
+            semantics=engine._semantics,
+            particles=engine._particles,
+            seed=engine._seed,
+            max_nodes=engine._max_nodes,
+            timeout=None if deadline is None else max(0.0, deadline - time.monotonic()),
+            progress=progress,
+            should_stop=out_of_time,
+        )
+    except Exception as error:  # the engine must answer, not raise
+        return result(
+            Status.INTERNAL_ERROR,
+            logs=[
+                LogMessage(LogLevel.ERROR, f"arrange-up failed: {type(error).__name__}: {error}")
+            ],
+        )
+
+    metrics = {key: _short(value) for key, value in outcome.stats.items()}
+    metrics.update(
+        status=outcome.status,
+        semantics=outcome.semantics,
+        particles=str(outcome.particles),
+        seed=str(outcome.seed),
+    )
+    limit = outcome.stats.get("max_nodes")
+    if outcome.status == planner.SOLVED and outcome.actions is not None:
+        logs = []
+        target = problem
+        if not made_by_to_up(problem):
+            target = to_up(arrangement, environment=problem.environment)
+            logs.append(
+                LogMessage(
+                    LogLevel.INFO,
+                    "the problem came from PDDL, whose actions have no real parameters: the "
+                    "plan's actions are those of arrange_up.compile.to_up(from_up(problem))",
+                )
+            )
+        plan = plan_to_up(target, [_plain(a) for a in outcome.actions])
+        return result(Status.SOLVED_SATISFICING, plan, logs, metrics)
+    if outcome.status == planner.TIMEOUT or (outcome.status == planner.CANCELLED and out_of_time()):
+        message = f"timeout of {timeout} s reached without a plan"
+        return result(Status.TIMEOUT, None, [LogMessage(LogLevel.INFO, message)], metrics)
+    if outcome.status == planner.NODE_LIMIT:
+        message = (
+            f"node limit of {limit} expanded nodes reached without a plan; the search is "
+            "incomplete, so the problem is not proven unsolvable"
+        )
+        return result(
+            Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
+        )
+    if outcome.status == planner.UNSOLVABLE:
+        message = (
+            "the search space was exhausted without a plan; the action generators and "
+            "dominance pruning make the search incomplete, so the problem is not proven "
+            "unsolvable"
+        )
+        return result(
+            Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
+        )
+    message = f"the planner stopped with status {outcome.status!r}"
+    return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)
+
+
+def _plain(action: Any) -> Any:
+    """The action with plain Python floats (the planner may hand out numpy scalars)."""
+    from dataclasses import replace
+
+    from arrange_up.world import Push
+
+    pose = tuple(float(v) for v in getattr(action, "pose", ()))
+    if isinstance(action, Push):
+        return replace(action, pose=pose, distance=float(action.distance))
+    if pose:
+        return replace(action, pose=pose)
+    return action
+
+
+def _short(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
