@@ -137,6 +137,25 @@ class IntervalBelief:
     def __contains__(self, name: object) -> bool:
         return any(other == name for other, _ in self.objects)
 
+    # The planner's view of a belief (shared with ParticleBelief): ``poses`` holds the box's
+    # low and high corners as two pseudo-particles. Goal tests, heuristics and dominance only
+    # use per-dimension minima and maxima of ``poses``, which are exactly the box's bounds.
+    @cached_property
+    def poses(self) -> np.ndarray:
+        """Array ``(2, n_objects, 3)``: the low and the high corner of every object's box."""
+        if not self.objects:
+            return np.zeros((2, 0, 3))
+        low = [iv.low for _, iv in self.objects]
+        high = [iv.high for _, iv in self.objects]
+        return np.array([low, high], dtype=float)
+
+    @property
+    def intervals(self) -> IntervalBelief:
+        return self
+
+    def __len__(self) -> int:
+        return 2
+
 
 def dominates(a: IntervalBelief, b: IntervalBelief, tol: float = 1e-9) -> bool:
     """Thesis §2.1.2: ``a`` dominates ``b`` iff both are defined on the same objects and every

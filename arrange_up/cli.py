@@ -236,6 +236,13 @@ def _actions_table(problem, actions) -> str:
     type=click.Choice(["inadmissible", "admissible", "ordering", "manhattan", "blind"]),
     help="Search heuristic (thesis §2.2.2, §3.2).",
 )
+@click.option(
+    "--weight",
+    type=click.FloatRange(0, None),
+    default=2.0,
+    show_default=True,
+    help="Weighted A*: f = g + weight * h (1 = A*).",
+)
 @click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
 @click.option(
     "--workers",
@@ -264,6 +271,7 @@ def plan(
     max_nodes: int | None,
     timeout: float | None,
     heuristic: str,
+    weight: float,
     no_dominance: bool,
     workers: int | None,
     output: str | None,
@@ -306,6 +314,7 @@ def plan(
             max_nodes=max_nodes,
             timeout=timeout,
             heuristic=heuristic,
+            weight=weight,
             dominance=not no_dominance,
             workers=workers,
             progress=update,

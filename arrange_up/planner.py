@@ -52,6 +52,11 @@ ProgressCallback = Callable[[dict[str, Any]], None]
 
 DEFAULT_MAX_NODES = 5000
 """The thesis's node limit (§3.3)."""
+DEFAULT_WEIGHT = 2.0
+"""Weighted A* by default: with the (already inadmissible) per-dimension count, A* spends most
+of its nodes on plateaus of equal f; weight 2 found the 50-particle 7-block plan within the
+node limit (3,303 nodes) where A* did not, and cut 50-particle blocks-4 from 766 nodes to 50,
+for plans one or two actions longer. ``weight=1`` gives the thesis's A*."""
 
 
 def plan(
@@ -64,7 +69,7 @@ def plan(
     timeout: float | None = None,
     heuristic: str = "inadmissible",
     dominance: bool = True,
-    weight: float = 1.0,
+    weight: float = DEFAULT_WEIGHT,
     deferred: bool = True,
     workers: int = 1,
     tie_break: bool = False,
@@ -94,7 +99,7 @@ def plan(
         dominated belief is pruned whatever its path cost), with a 0.01 in / 0.01 rad
         tolerance (see :class:`~arrange_up.belief.IntervalDominanceIndex`).
     weight
-        ``f = g + weight * h``; 1 is A*.
+        ``f = g + weight * h``; 1 is A*, the default 2 weighted A* (see :data:`DEFAULT_WEIGHT`).
     deferred
         Deferred evaluation: a successor is simulated only when it is taken off the open list,
         not when generated. Most generated successors are never expanded, and simulating them
@@ -171,6 +176,7 @@ def plan(
     stats["max_nodes"] = limit
     stats["heuristic"] = heuristic
     stats["dominance"] = dominance
+    stats["weight"] = weight
     return PlanResult(
         status=status,
         actions=tuple(result.plan) if result.plan is not None else None,

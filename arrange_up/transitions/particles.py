@@ -152,19 +152,16 @@ class ParticleSemantics:
 
     def _pool(self) -> Executor:
         if self._executor is None:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
+            # loky (joblib's process pool) rather than multiprocessing: it never re-imports the
+            # caller's __main__ (so scripts need no main guard) and reuses its workers.
+            from joblib.externals.loky import get_reusable_executor
 
-            self._executor = ProcessPoolExecutor(
-                max_workers=self.workers, mp_context=multiprocessing.get_context("spawn")
-            )
+            self._executor = get_reusable_executor(max_workers=self.workers)
         return self._executor
 
     def close(self) -> None:
-        """Shut down worker processes, if any."""
-        if self._executor is not None:
-            self._executor.shutdown(cancel_futures=True)
-            self._executor = None
+        """Release the worker pool (loky keeps idle workers for reuse and reaps them later)."""
+        self._executor = None
 
 
 class DeterministicSemantics(ParticleSemantics):
