@@ -9,8 +9,11 @@
 ;   invalid (Figure 4-11). The paddle is the 2.5 x 0.15 in real-robot paddle (the thesis gives
 ;   no size for this problem). Action uncertainty (+-0.2 in, +-1 deg) applies to every action:
 ;   to the paddle's approach pose of a push and to where a placed fixture lands. Goal tolerance
-;   +-0.5 in, +-15 deg is our choice: pushes are uncertain by +-0.2 in, so a tighter goal would
-;   leave almost no room.
+;   +-1.25 in across, +-0.5 in along the push, +-15 deg is our choice: the goal is about how far
+;   down the block went, and a downward push cannot narrow the +-1.0 in initial spread across it
+;   (the thesis reports the nominal plan "nearly perfect", which only a tolerance wider than
+;   that spread allows); along the push the paddle sets the block's position, uncertain by +-0.2
+;   in.
 (define (problem down-push)
   (:domain arrange-up)
   (:objects
@@ -33,7 +36,7 @@
   )
   (:goal (and
     (on-table block)
-    (>= (x block) 5.5) (<= (x block) 6.5)
+    (>= (x block) 4.75) (<= (x block) 7.25)
     (>= (y block) 2.5) (<= (y block) 3.5)
     (>= (theta block) -15) (<= (theta block) 15)
   ))
