@@ -347,9 +347,7 @@ def _describe(spec: ObjectSpec) -> _Manipulator:
 
 
 def _clean(pose: Pose) -> Pose:
-    """Round a generated pose to 1e-6 so plans print and compare cleanly."""
-    return (
-        round(float(pose[0]), 6) + 0.0,
-        round(float(pose[1]), 6) + 0.0,
-        round(float(pose[2]), 9) + 0.0,
-    )
+    """Round a generated pose's position to 1e-6 in so plans print and compare cleanly. The
+    angle is kept exact: it comes from exact axis directions (``-pi/2`` converts to exactly
+    -90 degrees only unrounded)."""
+    return (round(float(pose[0]), 6) + 0.0, round(float(pose[1]), 6) + 0.0, float(pose[2]) + 0.0)

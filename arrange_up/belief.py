@@ -12,7 +12,8 @@ Angles. A shape that looks the same after a rotation by ``2*pi/k`` (a square: k 
 physically identical poses ``theta`` and ``theta + 2*pi/k``; pymunk happily reports either.
 Every belief therefore stores angles *canonically*: wrapped into the half-open period
 ``[ref - period/2, ref + period/2)`` around the object's reference angle (its absolute goal
-angle if it has one, else 0). :func:`symmetry_period` finds the period from the geometry.
+angle if it has one, else its initial angle if it starts on the table, else 0).
+:func:`symmetry_period` finds the period from the geometry.
 """
 
 from __future__ import annotations
@@ -70,11 +71,15 @@ class AngleFrame:
             if spec.kind is ObjectKind.OBSTACLE:
                 continue
             period[spec.name] = symmetry_period(spec.shape)
-            reference[spec.name] = (
-                goal.target(spec.name)[2]
-                if not goal.is_relative and spec.name in goal.parts
-                else 0.0
-            )
+            initial = problem.initial_of(spec.name)
+            if not goal.is_relative and spec.name in goal.parts:
+                reference[spec.name] = goal.target(spec.name)[2]
+            elif initial is not None:
+                # Centre the period on where the object starts: wrapping at the start angle
+                # itself would split one belief across the period's two ends.
+                reference[spec.name] = initial.pose[2]
+            else:
+                reference[spec.name] = 0.0
         return cls(reference, period)
 
     def canonical(self, state: WorldState) -> WorldState:

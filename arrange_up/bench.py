@@ -15,14 +15,13 @@ differs: friction in [0.25, 0.55], part density in [0.1, 0.15], manipulator dens
 [0.35, 0.45], approach pose noise of +-0.02 in and +-0.01 rad, and each block's initial pose
 jittered by +-0.01 in and +-0.01 rad (blocks stand 0.05 in apart, so nothing overlaps).
 
-With more than one worker the pushes are split evenly over a joblib (loky) process pool that is
+With more than one worker the pushes are split evenly over the project's loky process pool that is
 started and warmed up (imports, first push) before the clock starts; its start-up time is
 reported separately as ``startup_seconds``.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -158,50 +157,54 @@ def bench_physics(
         scenes.append((name, problem, push, _tasks(problem, state, push, n_pushes, rng)))
 
     for count in workers:
-        with contextlib.ExitStack() as stack:
-            parallel = None
-            startup = 0.0
-            if count > 1:
-                from joblib import Parallel, delayed
+        executor = None
+        startup = 0.0
+        if count > 1:
+            # The project's shared process pool (arrange_up.parallel): planning and evaluation
+            # use the same one, and mixing it with a separate joblib.Parallel pool breaks loky.
+            from arrange_up.parallel import local_executor
 
-                if progress:
-                    progress(f"starting a pool of {count} worker processes")
+            if progress:
+                progress(f"starting a pool of {count} worker processes")
+            t0 = time.perf_counter()
+            executor = local_executor(count)
+            _, problem, push, tasks = scenes[0]
+            warm = [executor.submit(_warm, problem, push, tasks[:2], 0.2) for _ in range(count)]
+            for future in warm:
+                future.result()
+            startup = time.perf_counter() - t0
+        for name, problem, push, tasks in scenes:
+            if progress:
+                progress(f"{name}: {len(tasks)} pushes on {count} worker(s)")
+            if executor is None:
+                _run_chunk(problem, push, tasks[:2])  # warm this process's caches
                 t0 = time.perf_counter()
-                parallel = stack.enter_context(Parallel(n_jobs=count, backend="loky"))
-                _, problem, push, tasks = scenes[0]
-                parallel(delayed(_warm)(problem, push, tasks[:2], 0.2) for _ in range(count))
-                startup = time.perf_counter() - t0
-            for name, problem, push, tasks in scenes:
-                if progress:
-                    progress(f"{name}: {len(tasks)} pushes on {count} worker(s)")
-                if parallel is None:
-                    _run_chunk(problem, push, tasks[:2])  # warm this process's caches
-                    t0 = time.perf_counter()
-                    results = [_run_chunk(problem, push, tasks)]
-                    seconds = time.perf_counter() - t0
-                else:
-                    bounds = np.linspace(0, len(tasks), count + 1).round().astype(int)
-                    chunks = [tasks[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
-                    t0 = time.perf_counter()
-                    results = parallel(
-                        delayed(_run_chunk)(problem, push, chunk) for chunk in chunks if chunk
-                    )
-                    seconds = time.perf_counter() - t0
-                pushes = len(tasks)
-                rows.append(
-                    {
-                        "scene": name,
-                        "workers": count,
-                        "pushes": pushes,
-                        "seconds": seconds,
-                        "pushes_per_second": pushes / seconds,
-                        "ms_per_push": 1000.0 * seconds / pushes,
-                        "not_at_rest": sum(r[0] for r in results),
-                        "not_ok": sum(r[1] for r in results),
-                        "mean_sim_time": sum(r[2] for r in results) / pushes,
-                        "startup_seconds": startup,
-                    }
-                )
+                results = [_run_chunk(problem, push, tasks)]
+                seconds = time.perf_counter() - t0
+            else:
+                bounds = np.linspace(0, len(tasks), count + 1).round().astype(int)
+                chunks = [tasks[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+                t0 = time.perf_counter()
+                futures = [
+                    executor.submit(_run_chunk, problem, push, chunk) for chunk in chunks if chunk
+                ]
+                results = [future.result() for future in futures]
+                seconds = time.perf_counter() - t0
+            pushes = len(tasks)
+            rows.append(
+                {
+                    "scene": name,
+                    "workers": count,
+                    "pushes": pushes,
+                    "seconds": seconds,
+                    "pushes_per_second": pushes / seconds,
+                    "ms_per_push": 1000.0 * seconds / pushes,
+                    "not_at_rest": sum(r[0] for r in results),
+                    "not_ok": sum(r[1] for r in results),
+                    "mean_sim_time": sum(r[2] for r in results) / pushes,
+                    "startup_seconds": startup,
+                }
+            )
     return rows
 
 

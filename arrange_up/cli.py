@@ -11,6 +11,7 @@ errors under ``check``); 2 bad input (unreadable or invalid problem, unknown dom
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 from typing import NoReturn
 
@@ -41,6 +42,21 @@ def _load(problem: str):  # -> ArrangementProblem
         click.echo(str(error), err=True)
         n = sum(1 for d in error.diagnostics if d.severity == "error")
         _fail(f"{n} error{'s' if n != 1 else ''}; nothing was done")
+
+
+def _read_plan_for(problem, plan_file: str):  # -> (actions, document)
+    """Read a plan file for ``problem``: a clean message and exit 2 on a bad file, a warning
+    when the plan was made for other problem content."""
+    from arrange_up.planfile import PlanFileError, plan_problem_mismatch, read_plan
+
+    try:
+        actions, document = read_plan(plan_file, problem)
+    except PlanFileError as error:
+        _fail(str(error))
+    mismatch = plan_problem_mismatch(document, problem)
+    if mismatch:
+        click.echo(f"arrange-up: warning: {plan_file}: {mismatch}; using it anyway", err=True)
+    return actions, document
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
@@ -136,15 +152,101 @@ def domains() -> None:
     help="Where to write the picture (.png).",
 )
 @click.option("--dpi", type=click.IntRange(30, 600), default=150, show_default=True)
-def show(problem: str, output: str, dpi: int) -> None:
+@click.option(
+    "--plan",
+    "plan_file",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Draw a storyboard of this plan file: one panel per action.",
+)
+@click.option(
+    "--rollouts",
+    type=click.IntRange(0, 10_000),
+    default=50,
+    show_default=True,
+    help="Noisy rollouts overlaid in grey on the storyboard.",
+)
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="Seed of the storyboard's rollouts (as in `evaluate`).",
+)
+@click.option(
+    "--heatmap",
+    "heatmap_step",
+    type=click.IntRange(1, None),
+    default=None,
+    metavar="STEP",
+    help="With --plan: draw the fixture-placement scores of nominal step STEP "
+    "(thesis Figure 4-11); for a repaired plan, the repair's step number.",
+)
+def show(
+    problem: str,
+    output: str,
+    dpi: int,
+    plan_file: str | None,
+    rollouts: int,
+    seed: int,
+    heatmap_step: int | None,
+) -> None:
     """Draw PROBLEM: table, walls, obstacles, parts with their belief shadows, and the goal.
 
-    PROBLEM is a .yaml file or a shipped domain's name.
-    """
-    from arrange_up.render import draw_problem
+    With --plan, draw the plan's storyboard instead (thesis Figure 3-11): one panel per action
+    with the action, the nominal poses, the poses of --rollouts noisy rollouts in grey and the
+    belief shadows the planner predicted.
 
+    With --plan and --heatmap STEP, draw instead the score of every candidate fixture
+    placement for that step of the plan (thesis Figure 4-11), invalid ones marked.
+
+    \b
+    Examples:
+      arrange-up show blocks-4 -o blocks-4.png
+      arrange-up show blocks-4 --plan blocks-4.plan.json --rollouts 100 -o story.png
+      arrange-up show tz-mating --plan tz.json --heatmap 1 -o heat.png
+    """
     loaded = _load(problem)
-    path = draw_problem(loaded, Path(output), dpi=dpi)
+    if heatmap_step is not None and plan_file is None:
+        _fail("--heatmap needs --plan")
+    if plan_file is None:
+        from arrange_up.render import draw_problem
+
+        path = draw_problem(loaded, Path(output), dpi=dpi)
+        click.echo(f"wrote {path}")
+        return
+    actions, document = _read_plan_for(loaded, plan_file)
+    if heatmap_step is not None:
+        from arrange_up.render import write_heatmap
+        from arrange_up.repair import step_scores
+        from arrange_up.transitions.particles import default_workers
+
+        try:
+            scores = step_scores(
+                loaded, actions, heatmap_step, document=document, workers=default_workers()
+            )
+        except ValueError as error:
+            _fail(f"--heatmap: {error}")
+        path = write_heatmap(loaded, scores, Path(output), dpi=dpi)
+        click.echo(f"wrote {path}")
+        return
+    from arrange_up.storyboard import draw_storyboard
+    from arrange_up.transitions import available
+
+    semantics = document.get("semantics")
+    if semantics not in available():
+        semantics = "deterministic"  # e.g. repaired plans: show the nominal prediction
+    path = draw_storyboard(
+        loaded,
+        actions,
+        Path(output),
+        rollouts=rollouts,
+        seed=seed,
+        semantics=semantics,
+        particles=int(document.get("particles") or 1),
+        plan_seed=int(document.get("seed") or 0),
+        dpi=min(dpi, 150),
+    )
     click.echo(f"wrote {path}")
 
 
@@ -394,6 +496,575 @@ def export(problem: str, fmt: str, output: str) -> None:
 
     write_text_atomic(Path(output), text)
     click.echo(f"wrote {output}")
+
+
+# ---------------------------------------------------------------------------------------------
+# evaluate
+# ---------------------------------------------------------------------------------------------
+def _evaluation_progress(total: int):
+    """A rich progress bar on stderr for ``evaluate`` (None, None when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None, None
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    bar = Progress(
+        TextColumn("rollouts"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[summary]}"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+    task = bar.add_task("evaluate", total=total, summary="")
+    bar.start()
+
+    def update(state) -> None:
+        bar.update(
+            task,
+            completed=state.done,
+            summary=f"{state.successes} ok ({100.0 * state.rate:.1f}%)",
+        )
+
+    return update, bar
+
+
+def _describe_action(problem, actions, index: int) -> str:
+    """``action 3 (push paddle)``: 1-based, as in the plan table of ``arrange-up plan``."""
+    from arrange_up.world import Push
+
+    action = actions[index]
+    kind = type(action).__name__.lower()
+    who = action.manipulator if isinstance(action, Push) else action.obj
+    return f"action {index + 1} ({kind} {who})"
+
+
+def _failure_lines(problem, actions, failures) -> list[str]:
+    """The failure breakdown as text, in the problem's units and names."""
+    units = problem.units
+    tol = problem.goal.tolerance
+    lines = []
+    if failures.goal_missed:
+        lines.append(f"  goal missed      {failures.goal_missed:>7}")
+        for miss in failures.goal_misses:
+            if miss.dimension == "theta":
+                worst = f"{units.angle_out(miss.worst):.3g} {units.angle}"
+                bound = f"±{units.angle_out(tol[2] or 0.0):g} {units.angle}"
+            elif miss.dimension in ("x", "y"):
+                worst = f"{units.length_out(miss.worst):.3g} {units.length}"
+                index = 0 if miss.dimension == "x" else 1
+                bound = f"±{units.length_out(tol[index]):g} {units.length}"
+            else:
+                lines.append(f"    {miss.part} {miss.dimension}: {miss.rollouts}")
+                continue
+            lines.append(
+                f"    {miss.part} {miss.dimension}: {miss.rollouts} (worst {worst} beyond "
+                f"the {bound} tolerance)"
+            )
+    if failures.action_failed:
+        lines.append(f"  action failed    {failures.action_failed:>7}")
+        for entry in failures.action_failures:
+            lines.append(
+                f"    {_describe_action(problem, actions, entry.action)}: {entry.rollouts}: "
+                f"{entry.reason}"
+            )
+    if failures.not_at_rest:
+        lines.append(f"  not at rest      {failures.not_at_rest:>7}")
+        for entry in failures.not_at_rest_actions:
+            lines.append(
+                f"    {_describe_action(problem, actions, entry.action)}: {entry.rollouts}"
+            )
+    if failures.off_table:
+        lines.append(f"  off table        {failures.off_table:>7}")
+        for entry in failures.off_table_actions:
+            lines.append(
+                f"    {_describe_action(problem, actions, entry.action)}: {entry.object} "
+                f"{entry.rollouts}"
+            )
+    return lines
+
+
+@main.command()
+@click.argument("problem")
+@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
+@click.option(
+    "--rollouts",
+    type=click.IntRange(1, None),
+    default=1000,
+    show_default=True,
+    help="Noisy executions of the plan.",
+)
+@click.option(
+    "--seed",
+    type=click.IntRange(0, None),
+    default=0,
+    show_default=True,
+    help="Rollout i draws its noise from (seed, i): equal seeds give equal results.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(1, 1024),
+    default=None,
+    help="Worker processes (default: all cores; 1 runs in this process).",
+)
+@click.option(
+    "--backend",
+    type=click.Choice(["local", "dask"]),
+    default=None,
+    help="Where rollouts run: local processes (default) or a Dask cluster.",
+)
+@click.option(
+    "--scheduler",
+    metavar="ADDRESS",
+    default=None,
+    help="Address of a running Dask scheduler (implies --backend dask); without it the dask "
+    "backend starts a local cluster of --workers processes.",
+)
+@click.option(
+    "--record",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Append every rollout to this .jsonl file as it finishes; re-running with the same "
+    "file resumes the evaluation.",
+)
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print a machine-readable summary (JSON) on stdout.",
+)
+def evaluate(
+    problem: str,
+    plan_file: str,
+    rollouts: int,
+    seed: int,
+    workers: int | None,
+    backend: str | None,
+    scheduler: str | None,
+    record: str | None,
+    as_json: bool,
+) -> None:
+    """Estimate how reliably PLAN.json achieves PROBLEM's goal, by noisy rollouts.
+
+    Each rollout draws initial poses within the initial uncertainty, executes the plan open
+    loop in the physics with fresh place/push noise, friction and densities for every action,
+    and checks the goal. Prints successes / trials, the rate with its 95% Wilson interval, and
+    why the failures failed.
+
+    \b
+    Examples:
+      arrange-up evaluate blocks-4 blocks-4.plan.json --rollouts 1000
+      arrange-up evaluate blocks-4 b4.json --record b4.rollouts.jsonl --json
+      arrange-up evaluate blocks-4 b4.json --backend dask --scheduler tcp://10.0.0.5:8786
+
+    Exit status: 0 the evaluation ran (whatever the rate), 1 interrupted, 2 bad input.
+    """
+    import json
+
+    from arrange_up.evaluate import RecordFileError, evaluate_plan, plan_hash
+    from arrange_up.parallel import BackendUnavailableError
+    from arrange_up.problem import problem_hash
+
+    if scheduler is not None and backend == "local":
+        _fail("--scheduler: a scheduler address needs --backend dask")
+    backend = backend or ("dask" if scheduler is not None else "local")
+    loaded = _load(problem)
+    actions, document = _read_plan_for(loaded, plan_file)
+    this_hash = problem_hash(loaded)
+    update, bar = _evaluation_progress(rollouts)
+    try:
+        result = evaluate_plan(
+            loaded,
+            actions,
+            rollouts=rollouts,
+            seed=seed,
+            workers=workers,
+            backend=backend,
+            scheduler=scheduler,
+            record=record,
+            progress=update,
+        )
+    except KeyboardInterrupt:
+        if bar is not None:
+            bar.stop()
+        kept = f"; the finished rollouts are in {record}: run again to resume" if record else ""
+        _fail(f"interrupted{kept}", EXIT_NEGATIVE)
+    except (RecordFileError, BackendUnavailableError, ValueError) as error:
+        _fail(str(error))
+    finally:
+        if bar is not None:
+            bar.stop()
+    low, high = result.interval
+    if as_json:
+        summary = result.to_json()
+        summary.update(
+            rollouts=rollouts,
+            problem={"name": loaded.name, "hash": this_hash, "source": loaded.source},
+            plan={
+                "path": plan_file,
+                "hash": plan_hash(actions),
+                "actions": len(actions),
+                "problem": document.get("problem") or None,
+            },
+            record=record,
+        )
+        click.echo(json.dumps(summary, indent=2))
+        return
+    where = f"{result.backend}, {result.workers} worker{'s' if result.workers != 1 else ''}"
+    resumed = f", {result.resumed} resumed from {record}" if result.resumed else ""
+    click.echo(
+        f"{loaded.name}: {result.successes} of {result.trials} rollouts reached the goal: "
+        f"{100.0 * result.rate:.1f}% (95% Wilson interval {100.0 * low:.1f}%-{100.0 * high:.1f}%)"
+    )
+    click.echo(f"seed {seed}, {where}, {result.elapsed:.1f} s{resumed}")
+    if result.failures.total:
+        click.echo(f"failures: {result.failures.total}")
+        for line in _failure_lines(loaded, actions, result.failures):
+            click.echo(line)
+    if record:
+        click.echo(f"rollouts recorded in {record}")
+
+
+# ---------------------------------------------------------------------------------------------
+# repair
+# ---------------------------------------------------------------------------------------------
+@main.command()
+@click.argument("problem")
+@click.option(
+    "--plan",
+    "plan_file",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="The nominal plan to repair (a plan file); default: make one with the deterministic "
+    "planner.",
+)
+@click.option(
+    "--particles",
+    type=click.IntRange(1, 100_000),
+    default=150,
+    show_default=True,
+    help="Particles of the belief the candidates are scored on.",
+)
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="Seed for the particles, the noise and the nominal plan: equal seeds, equal plans.",
+)
+@click.option(
+    "--method",
+    type=click.Choice(["naive", "enhanced"]),
+    default="enhanced",
+    show_default=True,
+    help="Candidate placements: the whole workspace grid (naive) or the grid placements that "
+    "meet the part motion swath (enhanced).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(1, 256),
+    default=None,
+    help="Processes simulating particles (default: all cores).",
+)
+@click.option(
+    "--output",
+    "-o",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write the repaired plan file (JSON; semantics 'fixtures', per-step choices under "
+    "'repair').",
+)
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print a machine-readable summary (JSON) on stdout instead of the table.",
+)
+def repair(
+    problem: str,
+    plan_file: str | None,
+    particles: int,
+    seed: int,
+    method: str,
+    workers: int | None,
+    output: str | None,
+    as_json: bool,
+) -> None:
+    """Make a nominal plan for PROBLEM robust by placing fixtures (thesis ch. 4).
+
+    Every push of the nominal plan becomes place(fixture), push, pick(fixture) (or stays a
+    bare push, with its distance multiplied by 1 to 2) choosing what keeps the particle belief
+    closest to the nominal trajectory; place and pick actions stay. See docs/repair.md.
+
+    \b
+    Examples:
+      arrange-up repair tz-mating --particles 150 --output tz.fixtures.json
+      arrange-up repair tz-mating --plan tz.nominal.json --method naive --json
+
+    Exit status: 0 repaired, 1 the repair failed (a step whose every candidate pushes a part
+    off the table or never comes to rest), 2 bad input.
+    """
+    import json
+
+    from arrange_up.planfile import PlanFileError, read_plan, write_json_atomic
+    from arrange_up.repair import nominal_plans, repair_plan
+
+    loaded = _load(problem)
+    if plan_file is not None:
+        try:
+            nominal, _ = read_plan(plan_file, loaded)
+        except PlanFileError as error:
+            _fail(str(error))
+    else:
+        found = nominal_plans(loaded, 1, seed)
+        if not found:
+            _fail("the deterministic planner found no nominal plan to repair", EXIT_NEGATIVE)
+        nominal = found[0]
+    if workers is None:
+        from arrange_up.transitions.particles import default_workers
+
+        workers = default_workers()
+    interactive = sys.stderr.isatty()
+
+    def progress(info: dict) -> None:
+        if info["phase"] == "done":
+            click.echo(
+                f"step {info['step']}/{info['steps']} {info['kind']}: {info['choice']} "
+                f"({info['elapsed']:.1f} s)",
+                err=True,
+            )
+        elif info["phase"] == "placements":
+            click.echo(
+                f"step {info['step']}/{info['steps']} push: scoring {info['candidates']} "
+                "candidates…",
+                err=True,
+            )
+
+    try:
+        result = repair_plan(
+            loaded,
+            nominal,
+            particles=particles,
+            seed=seed,
+            method=method,
+            workers=workers,
+            progress=progress if interactive else None,
+        )
+    except KeyboardInterrupt:
+        _fail("interrupted; no plan was written", EXIT_NEGATIVE)
+    except ValueError as error:
+        _fail(str(error))
+    document = result.document(loaded)
+    if output:
+        write_json_atomic(Path(output), document)
+    if as_json:
+        summary = {k: v for k, v in document.items() if k != "actions"}
+        summary["reason"] = result.reason or None
+        summary["actions"] = document.get("actions")
+        summary["output"] = output
+        click.echo(json.dumps(summary, indent=2))
+    else:
+        stats = result.stats()
+        click.echo(
+            f"{loaded.name}: {result.status} ({method}, {particles} particles, seed {seed}) in "
+            f"{result.elapsed:.1f} s: {stats['pushes']} pushes, {stats['fixtures_placed']} "
+            f"fixtures placed, {result.simulations} simulations"
+        )
+        if result.reason:
+            click.echo(f"reason: {result.reason}")
+        for record in result.steps:
+            if record.kind != "push":
+                click.echo(f"  step {record.index + 1}: {record.kind} kept")
+                continue
+            chosen = "every candidate invalid"
+            if record.status == "ok":
+                where = (
+                    "no fixture"
+                    if record.pose is None
+                    else f"{record.fixture} at "
+                    + ", ".join(f"{v:.3g}" for v in loaded.units.pose_out(record.pose))
+                )
+                chosen = (
+                    f"{where}, push x{record.multiplier:g}: distance {record.distance:.3f} "
+                    f"(bare push {record.nominal_distance:.3f})"
+                )
+            click.echo(f"  step {record.index + 1}: {chosen}")
+        if result.actions is not None:
+            click.echo(_actions_table(loaded, result.actions))
+        if output:
+            click.echo(f"wrote {output}")
+    if not result.solved:
+        sys.exit(EXIT_NEGATIVE)
+
+
+@main.group()
+def experiment() -> None:
+    """Reproduce the thesis's experiments (CSV of every measurement + PNG summary).
+
+    Results are appended as they are measured; re-running the same command resumes, skipping
+    what the CSV already holds.
+    """
+
+
+def _say(message: str) -> None:
+    click.echo(f"[{time.strftime('%H:%M:%S')}] {message}", err=True)
+
+
+@experiment.command("transition-comparison")
+@click.option(
+    "--problems", default="blocks-4,blocks-7", show_default=True, help="Comma-separated problems."
+)
+@click.option(
+    "--particles",
+    "particle_counts",
+    default="5,25,50",
+    show_default=True,
+    help="Comma-separated particle counts of the particle planners.",
+)
+@click.option(
+    "--semantics",
+    "extra",
+    default=None,
+    help="Comma-separated further semantics (default: every other registered one).",
+)
+@click.option(
+    "--runs",
+    type=click.IntRange(1, 1000),
+    default=10,
+    show_default=True,
+    help="Planning runs (seeds 0..R-1) per problem and planner.",
+)
+@click.option(
+    "--rollouts",
+    type=click.IntRange(0, 1_000_000),
+    default=1000,
+    show_default=True,
+    help="Noisy rollouts per plan (0: no evaluation).",
+)
+@click.option("--max-nodes", type=click.IntRange(1, None), default=5000, show_default=True)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Planning time limit per run, seconds.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(1, 256),
+    default=None,
+    help="Worker processes (default: all cores).",
+)
+@click.option(
+    "--output-dir", type=click.Path(file_okay=False), default="results", show_default=True
+)
+def experiment_transition_comparison(
+    problems, particle_counts, extra, runs, rollouts, max_nodes, timeout, workers, output_dir
+) -> None:
+    """Figures 3-6 and 3-7: planning time and reliability of each belief transition."""
+    from arrange_up.experiments import Planner, default_planners, transition_comparison
+    from arrange_up.transitions import available
+
+    try:
+        counts = [int(n) for n in particle_counts.split(",") if n]
+    except ValueError:
+        _fail(f"--particles: expected comma-separated integers, got {particle_counts!r}")
+    planners = [
+        p for p in default_planners(counts) if p.semantics in ("deterministic", "particles")
+    ]
+    names = (
+        extra.split(",")
+        if extra
+        else [n for n in available() if n not in ("deterministic", "particles")]
+    )
+    for name in names:
+        if name not in available():
+            _fail(
+                f"--semantics: unknown semantics {name!r}; expected one of {', '.join(available())}"
+            )
+        planners.append(Planner(name, name, 1))
+    for name in problems.split(","):
+        _load(name)  # refuse bad problems before hours of work
+    path = transition_comparison(
+        Path(output_dir),
+        problems=problems.split(","),
+        planners=planners,
+        runs=runs,
+        rollouts=rollouts,
+        max_nodes=max_nodes,
+        timeout=timeout,
+        workers=workers,
+        progress=_say,
+    )
+    click.echo(f"wrote {path} and {path.with_suffix('.png')}")
+
+
+@experiment.command("search-table")
+@click.option(
+    "--problems",
+    default="blocks-1,blocks-2,blocks-3,blocks-4,blocks-7",
+    show_default=True,
+    help="Comma-separated problems.",
+)
+@click.option(
+    "--semantics",
+    default=None,
+    help="Belief transition (default: cbst when available, as in the thesis; else deterministic).",
+)
+@click.option("--particles", type=click.IntRange(1, 100_000), default=1, show_default=True)
+@click.option("--max-nodes", type=click.IntRange(1, None), default=5000, show_default=True)
+@click.option(
+    "--weight",
+    type=click.FloatRange(0, None),
+    default=1.0,
+    show_default=True,
+    help="1 = A*, as in the thesis's table.",
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Time limit per search, seconds.",
+)
+@click.option(
+    "--output-dir", type=click.Path(file_okay=False), default="results", show_default=True
+)
+def experiment_search_table(
+    problems, semantics, particles, max_nodes, weight, timeout, output_dir
+) -> None:
+    """Table 3.1: nodes expanded and plan cost for each heuristic, with and without
+    domination."""
+    from arrange_up.experiments import search_table
+    from arrange_up.transitions import available
+
+    if semantics is None:
+        semantics = "cbst" if "cbst" in available() else "deterministic"
+    if semantics not in available():
+        _fail(
+            f"--semantics: unknown semantics {semantics!r}; expected one of "
+            f"{', '.join(available())}"
+        )
+    for name in problems.split(","):
+        _load(name)
+    path = search_table(
+        Path(output_dir),
+        problems=problems.split(","),
+        semantics=semantics,
+        particles=particles,
+        max_nodes=max_nodes,
+        weight=weight,
+        timeout=timeout,
+        progress=_say,
+    )
+    click.echo(f"wrote {path} and {path.with_suffix('.png')}")
 
 
 @main.group()

@@ -37,6 +37,8 @@ class CollisionChecker:
             if spec.pose is not None
         }
         self.obstacle_boxes = {name: geom.bounds for name, geom in self.obstacles.items()}
+        self._fixed = list(self.obstacles.values()) + [_box_geom(b) for b in self.walls.values()]
+        self._wall_geoms = {edge: _box_geom(box) for edge, box in self.walls.items()}
         self._shadow_box = lru_cache(maxsize=200_000)(self._shadow_box_uncached)
         self._shadow_hull = lru_cache(maxsize=20_000)(self._shadow_hull_uncached)
 
@@ -46,9 +48,8 @@ class CollisionChecker:
         footprints = [
             geometry.footprint(self.shapes[name].parts, pose) for name, pose in state.poses
         ]
-        fixed = list(self.obstacles.values()) + [_box_geom(b) for b in self.walls.values()]
         for i, a in enumerate(footprints):
-            for b in footprints[i + 1 :] + fixed:
+            for b in footprints[i + 1 :] + self._fixed:
                 if a.intersects(b) and a.intersection(b).area > AREA_TOLERANCE:
                     return True
         return False
@@ -79,10 +80,10 @@ class CollisionChecker:
         """True if the object's shadow may touch a wall or an obstacle."""
         box = self.shadow_box(name, pose, half)
         hull = None
-        for wall in self.walls.values():
+        for edge, wall in self.walls.items():
             if geometry.boxes_overlap(box, wall, -CLEARANCE):
                 hull = hull or self.shadow_hull(name, pose, half)
-                if hull.distance(_box_geom(wall)) < CLEARANCE:
+                if hull.distance(self._wall_geoms[edge]) < CLEARANCE:
                     return True
         for obstacle_name, obstacle in self.obstacles.items():
             if geometry.boxes_overlap(box, self.obstacle_boxes[obstacle_name], -CLEARANCE):

@@ -34,8 +34,27 @@ Metrics hold the search statistics (expanded, generated, evaluated, pruned, elap
 Importing UP's engine machinery costs ~1.5 s (ConfigSpace, scipy), so :func:`register` never
 imports it: if UP's factory is already loaded it registers at once (idempotently), otherwise it
 installs an import hook that adds the engine to UP's default engine table as soon as UP loads
-its factory. Importing this module is as cheap; the engine class itself
-(:class:`ArrangeUpPlanner`) is built, importing UP, the first time it is asked for.
+its factory. Importing this module is as cheap; the engine classes themselves
+(:class:`ArrangeUpPlanner`, :class:`ArrangeUpReliability`) are built, importing UP, the first
+time they are asked for.
+
+**The reliability validator** ``PlanValidator(name="arrange-up-reliability")``
+(:class:`ArrangeUpReliability`) judges a plan by Monte Carlo rollouts under the problem's full
+noise (:func:`arrange_up.evaluate.evaluate_plan`): it answers ``VALID`` only when every
+rollout reaches the goal, ``INVALID`` otherwise (with a log message breaking the failures down,
+and ``reason`` set from the most frequent failure: ``UNSATISFIED_GOALS`` when that is a missed
+goal, else ``INAPPLICABLE_ACTION`` naming the action that failed most often), ``UNKNOWN`` when
+the problem or the plan cannot be converted or the evaluation fails. Metrics: ``successes``,
+``trials``, ``rate``, ``interval`` (the 95% Wilson interval as ``[low, high]``),
+``interval_low``, ``interval_high``, ``seed``, ``elapsed`` and the failure counts per kind.
+Parameters: ``rollouts`` (1000), ``seed`` (0), ``workers`` (``None``: all cores), ``backend``
+(``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address).
+
+    >>> from unified_planning.shortcuts import PlanValidator
+    >>> with PlanValidator(name="arrange-up-reliability", params={"rollouts": 100}) as v:
+    ...     check = v.validate(problem, result.plan)
+    >>> check.metrics["successes"], check.metrics["interval"]     # doctest: +SKIP
+    ('100', '[0.963, 1]')
 """
 
 from __future__ import annotations
@@ -48,11 +67,20 @@ TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
-# ArrangeUpPlanner is also public; it is built on first access (see ``__getattr__``)
-__all__ = ["ENGINE_CLASS", "ENGINE_NAME", "register"]
+# ArrangeUpPlanner and ArrangeUpReliability are also public; they are built on first access
+# (see ``__getattr__``)
+__all__ = ["ENGINE_CLASS", "ENGINE_NAME", "VALIDATOR_CLASS", "VALIDATOR_NAME", "register"]
 
 ENGINE_NAME = "arrange-up"
 ENGINE_CLASS = "ArrangeUpPlanner"
+VALIDATOR_NAME = "arrange-up-reliability"
+VALIDATOR_CLASS = "ArrangeUpReliability"
+#: Every engine the package registers: (name in UP's factory, class name in this module).
+ENGINES: tuple[tuple[str, str], ...] = (
+    (ENGINE_NAME, ENGINE_CLASS),
+    (VALIDATOR_NAME, VALIDATOR_CLASS),
+    ("arrange-up-fixtures", "ArrangeUpFixtureRepairer"),
+)
 _FACTORY_MODULE = "unified_planning.engines.factory"
 
 
@@ -60,12 +88,13 @@ _FACTORY_MODULE = "unified_planning.engines.factory"
 # registration (standard library only)
 # ---------------------------------------------------------------------------------------------
 def register(environment: Any = None) -> None:
-    """Make the ``arrange-up`` engine known to unified-planning; cheap and idempotent.
+    """Make arrange-up's engines (the ``arrange-up`` planner and the ``arrange-up-reliability``
+    validator) known to unified-planning; cheap and idempotent.
 
-    * UP's factory module already imported: add the engine to its default engine table (for
+    * UP's factory module already imported: add the engines to its default engine table (for
       environments created later) and to the factory of ``environment`` or of UP's global
       environment if it exists.
-    * Otherwise: install an import hook that adds the engine to the default table when UP
+    * Otherwise: install an import hook that adds the engines to the default table when UP
       imports its factory, so the global environment has it from the start. Nothing of UP is
       imported here.
     """
@@ -79,17 +108,20 @@ def register(environment: Any = None) -> None:
     if environment is None:
         env_module = sys.modules.get("unified_planning.environment")
         environment = getattr(env_module, "GLOBAL_ENVIRONMENT", None)
-    if environment is not None and ENGINE_NAME not in environment.factory.engines:
-        environment.factory.add_engine(ENGINE_NAME, __name__, ENGINE_CLASS)
+    if environment is not None:
+        for name, class_name in ENGINES:
+            if name not in environment.factory.engines:
+                environment.factory.add_engine(name, __name__, class_name)
 
 
 def _add_to_defaults(factory_module: Any) -> None:
     defaults = getattr(factory_module, "DEFAULT_ENGINES", None)
-    if isinstance(defaults, dict):
-        defaults.setdefault(ENGINE_NAME, (__name__, ENGINE_CLASS))
     preference = getattr(factory_module, "DEFAULT_ENGINES_PREFERENCE_LIST", None)
-    if isinstance(preference, list) and ENGINE_NAME not in preference:
-        preference.append(ENGINE_NAME)
+    for name, class_name in ENGINES:
+        if isinstance(defaults, dict):
+            defaults.setdefault(name, (__name__, class_name))
+        if isinstance(preference, list) and name not in preference:
+            preference.append(name)
 
 
 class _FactoryHook:
@@ -131,9 +163,13 @@ class _PatchingLoader:
         return getattr(self._loader, name)
 
 
-def __getattr__(name: str) -> Any:  # PEP 562: the engine class is built on first use
+def __getattr__(name: str) -> Any:  # PEP 562: the engine classes are built on first use
     if name == ENGINE_CLASS:
         return _engine_class()
+    if name == VALIDATOR_CLASS:
+        return _validator_class()
+    if name == "ArrangeUpFixtureRepairer":
+        return _repairer_class()
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -382,3 +418,349 @@ def _short(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
     return str(value)
+
+
+# ---------------------------------------------------------------------------------------------
+# the reliability validator (imports unified-planning)
+# ---------------------------------------------------------------------------------------------
+def _validator_class() -> type:
+    if "validator" not in _CACHE:
+        _CACHE["validator"] = _build_validator_class()
+    return _CACHE["validator"]
+
+
+def _build_validator_class() -> type:
+    from unified_planning.engines import Engine
+    from unified_planning.engines.mixins import PlanValidatorMixin
+
+    class ArrangeUpReliability(Engine, PlanValidatorMixin):
+        """Monte Carlo reliability of a plan under the problem's noise (see the module doc)."""
+
+        def __init__(
+            self,
+            rollouts: int = 1000,
+            seed: int = 0,
+            workers: int | None = None,
+            backend: str = "local",
+            scheduler: str | None = None,
+        ) -> None:
+            Engine.__init__(self)
+            PlanValidatorMixin.__init__(self)
+            _check_validator_params(rollouts, seed, workers, backend, scheduler)
+            self._rollouts = rollouts
+            self._seed = seed
+            self._workers = workers
+            self._backend = backend
+            self._scheduler = scheduler
+
+        @property
+        def name(self) -> str:
+            return VALIDATOR_NAME
+
+        @staticmethod
+        def supported_kind() -> Any:
+            return _supported_kind()
+
+        @staticmethod
+        def supports(problem_kind: Any) -> bool:
+            return bool(problem_kind <= _supported_kind())
+
+        @staticmethod
+        def supports_plan(plan_kind: Any) -> bool:
+            from unified_planning.plans import PlanKind
+
+            return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
+
+        def _validate(self, problem: Any, plan: Any) -> Any:
+            return _validate(self, problem, plan)
+
+    ArrangeUpReliability.__module__ = __name__
+    ArrangeUpReliability.__qualname__ = VALIDATOR_CLASS
+    return ArrangeUpReliability
+
+
+def _check_validator_params(
+    rollouts: Any, seed: Any, workers: Any, backend: Any, scheduler: Any
+) -> None:
+    def positive(value: Any) -> bool:
+        return isinstance(value, int) and not isinstance(value, bool) and value >= 1
+
+    if not positive(rollouts):
+        raise ValueError(f"{VALIDATOR_NAME}: rollouts must be a positive integer, got {rollouts!r}")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ValueError(f"{VALIDATOR_NAME}: seed must be a non-negative integer, got {seed!r}")
+    if workers is not None and not positive(workers):
+        raise ValueError(f"{VALIDATOR_NAME}: workers must be a positive integer, got {workers!r}")
+    if backend not in ("local", "dask"):
+        raise ValueError(f"{VALIDATOR_NAME}: backend must be 'local' or 'dask', got {backend!r}")
+    if scheduler is not None and (backend != "dask" or not isinstance(scheduler, str)):
+        raise ValueError(f"{VALIDATOR_NAME}: a scheduler address needs backend='dask'")
+
+
+def _validate(engine: Any, problem: Any, plan: Any) -> Any:
+    from unified_planning.engines import LogLevel, LogMessage, ValidationResult
+    from unified_planning.engines.results import FailedValidationReason, ValidationResultStatus
+
+    from arrange_up.compile import from_up, plan_from_up
+    from arrange_up.evaluate import GOAL_MISSED, evaluate_plan
+
+    def unknown(message: str) -> Any:
+        return ValidationResult(
+            ValidationResultStatus.UNKNOWN,
+            VALIDATOR_NAME,
+            log_messages=[LogMessage(LogLevel.ERROR, message)],
+        )
+
+    try:
+        arrangement = from_up(problem)
+    except ValueError as error:  # ProblemFormatError is a ValueError
+        return unknown(f"not an arrange-up problem: {error}")
+    try:
+        actions = plan_from_up(plan)
+    except (AttributeError, TypeError, ValueError) as error:
+        return unknown(f"not a sequential plan of place/push/pick actions: {error}")
+    try:
+        outcome = evaluate_plan(
+            arrangement,
+            actions,
+            rollouts=engine._rollouts,
+            seed=engine._seed,
+            workers=engine._workers,
+            backend=engine._backend,
+            scheduler=engine._scheduler,
+        )
+    except Exception as error:  # the engine must answer, not raise
+        return unknown(f"the evaluation failed: {type(error).__name__}: {error}")
+
+    failures = outcome.failures
+    low, high = outcome.interval
+    metrics = {
+        "successes": str(outcome.successes),
+        "trials": str(outcome.trials),
+        "rate": f"{outcome.rate:.6g}",
+        "interval": f"[{low:.6g}, {high:.6g}]",
+        "interval_low": f"{low:.6g}",
+        "interval_high": f"{high:.6g}",
+        "seed": str(outcome.seed),
+        "elapsed": f"{outcome.elapsed:.6g}",
+        "goal_missed": str(failures.goal_missed),
+        "action_failed": str(failures.action_failed),
+        "not_at_rest": str(failures.not_at_rest),
+        "off_table": str(failures.off_table),
+    }
+    summary = (
+        f"{outcome.successes} of {outcome.trials} rollouts reached the goal (rate "
+        f"{outcome.rate:.4g}, 95% Wilson interval [{low:.4g}, {high:.4g}], seed {outcome.seed})"
+    )
+    if outcome.successes == outcome.trials:
+        return ValidationResult(
+            ValidationResultStatus.VALID,
+            VALIDATOR_NAME,
+            log_messages=[LogMessage(LogLevel.INFO, summary)],
+            metrics=metrics,
+        )
+    # the most frequent failure decides UP's reason
+    per_action: dict[int, int] = {}
+    for entry in (
+        *failures.action_failures,
+        *failures.not_at_rest_actions,
+        *failures.off_table_actions,
+    ):
+        per_action[entry.action] = per_action.get(entry.action, 0) + entry.rollouts
+    worst_action = max(per_action, key=lambda a: (per_action[a], -a), default=None)
+    lines = [summary + "; failures:"]
+    if failures.goal_missed:
+        parts = ", ".join(f"{m.part} {m.dimension} {m.rollouts}" for m in failures.goal_misses)
+        lines.append(f"  {GOAL_MISSED}: {failures.goal_missed} ({parts})")
+    for entry in failures.action_failures:
+        lines.append(f"  action {entry.action} failed in {entry.rollouts}: {entry.reason}")
+    for entry in failures.not_at_rest_actions:
+        lines.append(f"  action {entry.action} did not come to rest in {entry.rollouts}")
+    for entry in failures.off_table_actions:
+        lines.append(
+            f"  action {entry.action} put {entry.object} off the table in {entry.rollouts}"
+        )
+    if worst_action is None or failures.goal_missed >= per_action[worst_action]:
+        reason, inapplicable = FailedValidationReason.UNSATISFIED_GOALS, None
+    else:
+        reason = FailedValidationReason.INAPPLICABLE_ACTION
+        inapplicable = plan.actions[worst_action]
+    return ValidationResult(
+        ValidationResultStatus.INVALID,
+        VALIDATOR_NAME,
+        log_messages=[LogMessage(LogLevel.INFO, "\n".join(lines))],
+        reason=reason,
+        inapplicable_action=inapplicable,
+        metrics=metrics,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# the fixture-placement plan repairer (imports unified-planning)
+# ---------------------------------------------------------------------------------------------
+REPAIRER_NAME = "arrange-up-fixtures"
+REPAIRER_CLASS = "ArrangeUpFixtureRepairer"
+
+
+def _repairer_class() -> type:
+    if "repairer" not in _CACHE:
+        _CACHE["repairer"] = _build_repairer_class()
+    return _CACHE["repairer"]
+
+
+def _build_repairer_class() -> type:
+    from unified_planning.engines import Engine
+    from unified_planning.engines.mixins import PlanRepairerMixin
+
+    class ArrangeUpFixtureRepairer(Engine, PlanRepairerMixin):
+        """Fixture-placement plan repair (thesis ch. 4, :func:`arrange_up.repair.repair_plan`):
+        ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
+
+        Parameters: ``particles`` (150), ``seed`` (0), ``method`` (``"enhanced"`` or
+        ``"naive"``), ``workers`` (1). The plan is the nominal plan to repair (a
+        ``SequentialPlan`` of place/push/pick); the result is a ``PlanGenerationResult``:
+        ``SOLVED_SATISFICING`` with the repaired plan, ``UNSOLVABLE_INCOMPLETELY`` when a step
+        could not be repaired (the log message says which and why; the repair is greedy, so
+        nothing is proven), ``UNSUPPORTED_PROBLEM`` when the problem or plan is not
+        arrange-up's (or the plan fails in the deterministic semantics), ``INTERNAL_ERROR`` when
+        the repair raised. Metrics: ``status``, ``elapsed``, ``simulations``, ``pushes``,
+        ``fixtures_placed``, ``plan_length``, ``method``, ``particles``, ``seed`` and
+        ``step_K`` (the choice made for nominal step K).
+        """
+
+        def __init__(
+            self,
+            particles: int = 150,
+            seed: int = 0,
+            method: str = "enhanced",
+            workers: int = 1,
+        ) -> None:
+            Engine.__init__(self)
+            PlanRepairerMixin.__init__(self)
+            _check_repairer_params(particles, seed, method, workers)
+            self._particles = particles
+            self._seed = seed
+            self._method = method
+            self._workers = workers
+
+        @property
+        def name(self) -> str:
+            return REPAIRER_NAME
+
+        @staticmethod
+        def supported_kind() -> Any:
+            return _supported_kind()
+
+        @staticmethod
+        def supports(problem_kind: Any) -> bool:
+            return bool(problem_kind <= _supported_kind())
+
+        @staticmethod
+        def supports_plan(plan_kind: Any) -> bool:
+            from unified_planning.plans import PlanKind
+
+            return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
+
+        def _repair(self, problem: Any, plan: Any) -> Any:
+            return _repair(self, problem, plan)
+
+    ArrangeUpFixtureRepairer.__module__ = __name__
+    ArrangeUpFixtureRepairer.__qualname__ = REPAIRER_CLASS
+    return ArrangeUpFixtureRepairer
+
+
+def _check_repairer_params(particles: Any, seed: Any, method: Any, workers: Any) -> None:
+    def positive(value: Any) -> bool:
+        return isinstance(value, int) and not isinstance(value, bool) and value >= 1
+
+    if not positive(particles):
+        raise ValueError(
+            f"{REPAIRER_NAME}: particles must be a positive integer, got {particles!r}"
+        )
+    if not isinstance(seed, int) or isinstance(seed, bool):
+        raise ValueError(f"{REPAIRER_NAME}: seed must be an integer, got {seed!r}")
+    if method not in ("naive", "enhanced"):
+        raise ValueError(f"{REPAIRER_NAME}: method must be 'naive' or 'enhanced', got {method!r}")
+    if not positive(workers):
+        raise ValueError(f"{REPAIRER_NAME}: workers must be a positive integer, got {workers!r}")
+
+
+def _repair(engine: Any, problem: Any, plan: Any) -> Any:
+    from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
+    from unified_planning.engines import PlanGenerationResultStatus as Status
+
+    from arrange_up.compile import from_up, made_by_to_up, plan_from_up, plan_to_up, to_up
+    from arrange_up.repair import repair_plan
+
+    def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
+        return PlanGenerationResult(
+            status, plan, REPAIRER_NAME, metrics=metrics, log_messages=list(logs) or None
+        )
+
+    def refuse(message: str) -> Any:
+        return result(Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, message)])
+
+    try:
+        arrangement = from_up(problem)
+    except ValueError as error:  # ProblemFormatError is a ValueError
+        return refuse(f"not an arrange-up problem: {error}")
+    try:
+        nominal = plan_from_up(plan)
+    except (AttributeError, TypeError, ValueError) as error:
+        return refuse(f"not a sequential plan of place/push/pick actions: {error}")
+    try:
+        outcome = repair_plan(
+            arrangement,
+            nominal,
+            particles=engine._particles,
+            seed=engine._seed,
+            method=engine._method,
+            workers=engine._workers,
+        )
+    except ValueError as error:
+        return refuse(f"the plan cannot be repaired: {error}")
+    except Exception as error:  # the engine must answer, not raise
+        return result(
+            Status.INTERNAL_ERROR,
+            logs=[
+                LogMessage(
+                    LogLevel.ERROR, f"{REPAIRER_NAME} failed: {type(error).__name__}: {error}"
+                )
+            ],
+        )
+    stats = outcome.stats()
+    metrics = {key: _short(value) for key, value in stats.items()}
+    metrics.update(
+        status=outcome.status,
+        method=outcome.method,
+        particles=str(outcome.particles),
+        seed=str(outcome.seed),
+    )
+    for record in outcome.steps:
+        if record.kind != "push":
+            metrics[f"step_{record.index + 1}"] = f"{record.kind} kept"
+        elif record.status != "ok":
+            metrics[f"step_{record.index + 1}"] = "failed"
+        else:
+            where = "no fixture" if record.pose is None else f"{record.fixture} at {record.pose}"
+            metrics[f"step_{record.index + 1}"] = f"{where}, x{record.multiplier:g}"
+    if not outcome.solved or outcome.actions is None:
+        return result(
+            Status.UNSOLVABLE_INCOMPLETELY,
+            None,
+            [LogMessage(LogLevel.INFO, f"the repair {outcome.status}: {outcome.reason}")],
+            metrics,
+        )
+    logs = []
+    target = problem
+    if not made_by_to_up(problem):
+        target = to_up(arrangement, environment=problem.environment)
+        logs.append(
+            LogMessage(
+                LogLevel.INFO,
+                "the problem came from PDDL, whose actions have no real parameters: the "
+                "plan's actions are those of arrange_up.compile.to_up(from_up(problem))",
+            )
+        )
+    repaired = plan_to_up(target, [_plain(a) for a in outcome.actions])
+    return result(Status.SOLVED_SATISFICING, repaired, logs, metrics)

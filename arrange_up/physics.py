@@ -23,8 +23,11 @@ Model
 =====
 * **Bodies.** A movable object in the state is a dynamic body of mass ``density * area`` and
   moment ``sum(moment_for_poly(density * area_i, part_i))`` over its convex parts (the parts are
-  centred on the shape's centroid, which is the body origin). Parts and fixtures use
+  centred on the shape's centroid, which is the body origin). Parts use
   ``noise.part_density``; a manipulator resting on the table uses ``noise.manipulator_density``.
+* **Fixtures** are clamped to the table while they are on it: kinematic bodies that nothing can
+  move. A fixture is a movable obstacle the robot places to push parts *against* (thesis ch. 4,
+  Figure 4-1); a fixture as light as a part would just be pushed along with it.
   Mass and moment are set explicitly (shape density would leave rounding in the centre of
   gravity and break bit-identical replay).
 * **Table friction** is pymunk's "tank" pattern: a ``PivotJoint`` and a ``GearJoint`` from each
@@ -641,6 +644,20 @@ def _push(
         # 2. movable bodies, in state order, with table friction
         for obj, (x, y, th) in state.poses:
             body_def = compiled.bodies[obj]
+            if body_def.kind is ObjectKind.FIXTURE:
+                # Clamped to the table (see the module docstring): a kinematic body that
+                # never moves, with no table friction to model.
+                body = lib.cpBodyNewKinematic()
+                bodies.append(body)
+                lib.cpBodySetPosition(body, (x, y))
+                lib.cpBodySetAngle(body, th)
+                lib.cpSpaceAddBody(space, body)
+                for count, verts in body_def.parts:
+                    shape = new_poly(body, count, verts, identity, 0.0)
+                    shapes.append(shape)
+                    set_friction(shape, shape_mu)
+                    add_shape(space, shape)
+                continue
             rho = (
                 noise.manipulator_density
                 if body_def.kind is ObjectKind.MANIPULATOR

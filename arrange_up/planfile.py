@@ -20,7 +20,8 @@ and ``repair``) is a JSON object::
 Poses and distances are in the problem's own units (``units``). ``actions`` is present, and
 the plan complete, only when ``status`` is ``"solved"``; any other status records an honest
 failure with its search statistics. ``hash`` identifies the problem's content (see
-:func:`arrange_up.problem.problem_hash`); readers warn when it does not match.
+:func:`arrange_up.problem.problem_hash`); the commands that read plans warn when it does not
+match the problem they are given (:func:`plan_problem_mismatch`).
 """
 
 from __future__ import annotations
@@ -199,6 +200,17 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
         for i, item in enumerate(raw_actions)
     )
     return actions, document
+
+
+def plan_problem_mismatch(document: Mapping[str, Any], problem: ArrangementProblem) -> str | None:
+    """A warning if the plan ``document`` was made for a problem other than ``problem``."""
+    recorded = document.get("problem", {}) if isinstance(document, Mapping) else {}
+    if recorded.get("hash") not in (None, problem_hash(problem)):
+        return (
+            f"it was planned for problem {recorded.get('name')!r} with other content "
+            f"than {problem.name!r} ({recorded.get('hash')} vs {problem_hash(problem)})"
+        )
+    return None
 
 
 def _pose_out(pose: Sequence[float], units: Units) -> list[float]:

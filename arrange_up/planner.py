@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from arrange_up.problem import ArrangementProblem
-from arrange_up.world import Action
+from arrange_up.world import Action, Push
 
 #: Statuses of a planning run, as they appear in plan files and ``--json`` output.
 SOLVED = "solved"
@@ -73,6 +73,7 @@ def plan(
     deferred: bool = True,
     workers: int = 1,
     tie_break: bool = False,
+    variety: bool = False,
     progress: ProgressCallback | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> PlanResult:
@@ -110,6 +111,14 @@ def plan(
         Break ties among equally good nodes at random from ``seed`` (gives different but
         equally good plans for different seeds, e.g. for plan repair); default first-in
         first-out.
+    variety
+        Deliberate variety for nominal plans (plan repair, thesis ch. 4): every push the action
+        generator proposes is, with probability :data:`VARIETY_SPLIT`, offered cut short to a
+        random 40-80% of its distance instead of whole. The draws derive from ``seed`` and the
+        belief, so a run is reproducible, and different seeds search different action sets:
+        they return different plans (pushes in another order, or split in two), where
+        ``tie_break`` alone only reorders the few goal-directed pushes of a belief. Plans stay
+        valid plans of the unchanged problem.
     progress
         Receives a dict of search statistics about every 0.2 s.
     should_stop
@@ -137,6 +146,8 @@ def plan(
 
     def successors(belief: ParticleBelief):
         for action in generator.candidates(belief.intervals):
+            if variety and isinstance(action, Push):
+                action = _vary_push(action, belief, seed)
             yield Edge(action, 1.0, _bind(model.apply, belief, action))
 
     def is_goal(belief: ParticleBelief) -> bool:
@@ -186,6 +197,26 @@ def plan(
         stats=stats,
         beliefs=tuple(result.states) if result.states is not None else None,
     )
+
+
+#: Probability that ``variety`` offers a push cut short instead of whole.
+VARIETY_SPLIT = 0.5
+
+
+def _vary_push(push: Push, belief: Any, seed: int) -> Push:
+    """``push`` as ``variety`` offers it: whole, or cut to 40-80% of its distance, drawn from
+    ``(seed, belief, push)`` (see :func:`plan`)."""
+    import dataclasses
+    import hashlib
+
+    import numpy as np
+
+    key = repr((belief.names(), belief.poses.tolist(), push)).encode()
+    digest = int.from_bytes(hashlib.blake2b(key, digest_size=8).digest(), "little")
+    rng = np.random.default_rng([seed, 0x7A41E7, digest])
+    if rng.random() >= VARIETY_SPLIT:
+        return push
+    return dataclasses.replace(push, distance=round(push.distance * rng.uniform(0.4, 0.8), 4))
 
 
 def _bind(apply: Callable[[Any, Any], Any], belief: Any, action: Any) -> Callable[[], Any]:

@@ -35,6 +35,7 @@ if TYPE_CHECKING:
 __all__ = [
     "PART_COLORS",
     "draw_goal",
+    "draw_heatmap",
     "draw_initial",
     "draw_legend",
     "draw_object",
@@ -43,8 +44,10 @@ __all__ = [
     "draw_shadows",
     "draw_table",
     "goal_tolerance_half_widths",
+    "heatmap_figure",
     "object_color",
     "off_table_note",
+    "write_heatmap",
 ]
 
 #: Fill colours of parts, in the order the problem declares them (matplotlib's tab10, minus the
@@ -659,6 +662,282 @@ def draw_problem(
     if output.parent != Path(""):
         output.parent.mkdir(parents=True, exist_ok=True)
     fig = problem_figure(problem, title=title)
+    try:
+        fig.savefig(output, dpi=dpi, bbox_inches="tight", format="png")
+    finally:
+        plt.close(fig)
+    return output
+
+
+# ---------------------------------------------------------------------------------------------
+# fixture-placement heatmap (thesis Figure 4-11)
+# ---------------------------------------------------------------------------------------------
+#: Colour map of candidate scores (0, the best, is its low end: cyan; 1 is magenta).
+HEATMAP_CMAP = "cool"
+BLOCKED_COLOR = "#d62728"
+#: Half-length (inches) of the short bar that marks a candidate placement's pose and direction.
+HEATMAP_MARK = 0.17
+INVALID_FACE = "white"
+
+
+def draw_heatmap(
+    ax: Axes,
+    problem: ArrangementProblem,
+    scores: Any,
+    *,
+    particles: bool = True,
+    blocked: bool = True,
+    footprints: bool = False,
+    cmap: str = HEATMAP_CMAP,
+    colorbar: bool = True,
+) -> list[Any]:
+    """Draw the candidate placements of one push coloured by score (thesis Figure 4-11).
+
+    ``scores`` is a :class:`arrange_up.repair.StepScores` (:func:`arrange_up.repair.step_scores`
+    computes it). Drawn: the table; the nominal state before the push (parts filled, faded) and
+    after it (dashed outlines); with ``particles`` every particle's parts as faint outlines;
+    the part motion swaths (dotted boxes); the paddle at its approach pose with an arrow over
+    the nominal push distance; and every candidate placement of the placement stage:
+
+    * valid: a short bar along the fixture's long axis at its commanded pose
+      (``footprints=True``: its whole footprint, translucent), coloured by its min-max
+      normalised score with ``cmap`` (0, the closest to the nominal next state, is the low
+      end);
+    * invalid (some particle's push failed: pushed off the table, not at rest): white with a
+      grey edge, as the thesis draws them;
+    * blocked by the place precondition (``blocked``): a thin red cross;
+    * the winner of the one-step problem (if it places a fixture) as a thick black outline.
+
+    Returns the artists added (the colour bar's axes excluded).
+    """
+    import numpy as np
+    from matplotlib import colormaps
+    from matplotlib.colors import Normalize
+
+    from arrange_up import geometry
+
+    artists: list[Any] = list(draw_table(ax, problem))
+    colors = {p.name: object_color(problem, p.name) for p in problem.parts}
+    before = scores.nominal_state.as_dict()
+    after = scores.nominal_next.as_dict()
+    for name, pose in before.items():
+        spec = problem.object(name)
+        if spec.kind is ObjectKind.PART:
+            artists += draw_object(
+                ax, spec, pose, color=colors[name], alpha=0.45, label=name, zorder=3
+            )
+    if particles:
+        for state in scores.belief.particles:
+            for name, pose in state.poses:
+                spec = problem.object(name)
+                if spec.kind is not ObjectKind.PART:
+                    continue
+                artists += draw_object(
+                    ax,
+                    spec,
+                    pose,
+                    color=colors[name],
+                    fill=False,
+                    alpha=0.12,
+                    linewidth=0.5,
+                    zorder=2.5,
+                )
+    for name, pose in after.items():
+        spec = problem.object(name)
+        if spec.kind is ObjectKind.PART:
+            artists += draw_object(
+                ax, spec, pose, color=colors[name], fill=False, linestyle="--", zorder=3.6
+            )
+    for name, (x0, y0, x1, y1) in scores.swaths:
+        artists += ax.plot(
+            [x0, x1, x1, x0, x0],
+            [y0, y0, y1, y1, y0],
+            color=colors.get(name, "black"),
+            linestyle=":",
+            linewidth=1.2,
+            zorder=3.2,
+        )
+    # the paddle (backed-off approach) and the nominal push
+    push = scores.push
+    paddle = problem.object(push.manipulator)
+    best = scores.best
+    approach = best.push if best is not None and best.push is not None else push
+    artists += draw_object(ax, paddle, approach.pose, color=MANIPULATOR_COLOR, zorder=4)
+    px, py = paddle.push_direction
+    c, s = math.cos(approach.pose[2]), math.sin(approach.pose[2])
+    ux, uy = c * px - s * py, s * px + c * py
+    length = push.distance + scores.backoff
+    artists.append(
+        ax.annotate(
+            "",
+            xy=(approach.pose[0] + ux * length, approach.pose[1] + uy * length),
+            xytext=(approach.pose[0], approach.pose[1]),
+            arrowprops={"arrowstyle": "->", "color": MANIPULATOR_COLOR, "linewidth": 1.4},
+            zorder=4.1,
+        )
+    )
+
+    norm = Normalize(0.0, 1.0)
+    colormap = colormaps[cmap]
+    placements = [c for c in scores.placements if c.fixture is not None and c.pose is not None]
+    # worst first, so the best end up on top
+    order = sorted(
+        placements,
+        key=lambda c: (
+            {"blocked": 0, "invalid": 1}.get(c.status, 2),
+            -(c.score if c.score is not None else 0.0),
+        ),
+    )
+    for cand in order:
+        spec = problem.object(cand.fixture)
+        x, y, theta = cand.pose
+        if cand.status == "blocked":
+            if blocked:
+                artists += ax.plot(
+                    x, y, marker="x", color=BLOCKED_COLOR, markersize=3, alpha=0.5, zorder=3.3
+                )
+            continue
+        if cand.status == "ok":
+            color = colormap(norm(cand.score if cand.score is not None else 0.0))
+            edge = "none"
+        else:
+            color, edge = INVALID_FACE, "#777777"
+        if footprints:
+            artists += [
+                ax.add_patch(p)
+                for p in _polygon_patches(
+                    geometry.footprint(spec.shape.parts, cand.pose),
+                    facecolor=color,
+                    edgecolor=edge if edge != "none" else color,
+                    alpha=0.55,
+                    linewidth=0.5,
+                    zorder=3.4,
+                )
+            ]
+        else:
+            xmin, ymin, xmax, ymax = spec.shape.extent
+            half = HEATMAP_MARK
+            along = 0.0 if (xmax - xmin) >= (ymax - ymin) else 0.5 * math.pi
+            dx, dy = half * math.cos(theta + along), half * math.sin(theta + along)
+            if edge != "none":
+                artists += ax.plot(
+                    [x - dx, x + dx],
+                    [y - dy, y + dy],
+                    color=edge,
+                    linewidth=4.2,
+                    solid_capstyle="butt",
+                    zorder=3.4,
+                )
+            artists += ax.plot(
+                [x - dx, x + dx],
+                [y - dy, y + dy],
+                color=color,
+                linewidth=3.0,
+                solid_capstyle="butt",
+                zorder=3.45,
+            )
+    if best is not None and best.fixture is not None and best.pose is not None:
+        spec = problem.object(best.fixture)
+        artists += draw_object(
+            ax,
+            spec,
+            best.pose,
+            color="black",
+            fill=False,
+            linewidth=1.6,
+            label="best",
+            label_size=7,
+            zorder=4.5,
+        )
+    if colorbar:
+        from matplotlib.cm import ScalarMappable
+
+        mappable = ScalarMappable(norm=norm, cmap=colormap)
+        mappable.set_array(np.array([]))
+        bar = ax.figure.colorbar(mappable, ax=ax, shrink=0.8, pad=0.02)
+        bar.set_label("normalised distance to the nominal next state (0 = best)", fontsize=8)
+    return artists
+
+
+def heatmap_figure(
+    problem: ArrangementProblem, scores: Any, *, title: str | None = None, **kwargs: Any
+) -> Figure:
+    """A figure with :func:`draw_heatmap` of ``scores`` and a summary; ``kwargs`` go to
+    :func:`draw_heatmap`. The caller owns the figure (close it with ``plt.close(fig)``)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    plt = _plt()
+    width, depth = problem.table.size
+    fig, ax = plt.subplots(
+        figsize=(8.8, 7.0 * depth / max(width, 1e-9) + 0.6), layout="constrained"
+    )
+    draw_heatmap(ax, problem, scores, **kwargs)
+    pad = WALL_DRAW_THICKNESS + 0.3
+    boxes = [(-pad, -pad, width + pad, depth + pad)] + [box for _, box in scores.swaths]
+    (x0, x1), (y0, y1) = _limits(boxes, 0.2)
+    _style_axes(ax, (max(x0, -3.0), min(x1, width + 3.0)), (max(y0, -3.0), min(y1, depth + 3.0)))
+    placements = [c for c in scores.placements if c.fixture is not None]
+    counts = {k: sum(1 for c in placements if c.status == k) for k in ("ok", "invalid", "blocked")}
+    bare = scores.no_fixture
+    bare_text = (
+        f"no fixture: score {bare.score:.3g}, distance {bare.distance:.3g} in"
+        if bare.valid and bare.score is not None
+        else f"no fixture: invalid ({bare.reason})"
+    )
+    best = scores.best
+    if best is None:
+        choice = "every candidate is invalid"
+    elif best.fixture is None:
+        choice = f"chosen: no fixture, push x{best.multiplier:g}"
+    else:
+        choice = f"chosen: {best.fixture} (outlined), push x{best.multiplier:g}"
+    ax.set_title(
+        title
+        or (
+            f"{problem.name}: step {scores.step + 1}, candidates at "
+            f"{scores.selection_multiplier:g}x the push ({scores.method}, "
+            f"{len(scores.belief)} particles)"
+        ),
+        fontsize=10,
+    )
+    ax.text(
+        0.01,
+        0.01,
+        f"{counts['ok']} valid, {counts['invalid']} invalid (white), {counts['blocked']} "
+        f"blocked (x)\n{bare_text}\n{choice}",
+        transform=ax.transAxes,
+        fontsize=7.5,
+        family="monospace",
+        va="bottom",
+        bbox={"boxstyle": "round", "facecolor": "white", "edgecolor": "#bbbbbb", "alpha": 0.9},
+        zorder=6,
+    )
+    handles = [
+        Patch(facecolor=INVALID_FACE, edgecolor="#777777", label="invalid outcome"),
+        Line2D([], [], marker="x", color=BLOCKED_COLOR, linestyle="none", label="blocked"),
+        Line2D([], [], color="black", linestyle=":", label="part motion swath"),
+        Line2D([], [], color="black", linestyle="--", label="nominal next state"),
+    ]
+    ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.9).set_zorder(6)
+    return fig
+
+
+def write_heatmap(
+    problem: ArrangementProblem,
+    scores: Any,
+    output: str | Path,
+    *,
+    dpi: int = 150,
+    title: str | None = None,
+    **kwargs: Any,
+) -> Path:
+    """Save :func:`heatmap_figure` of ``scores`` as a PNG at ``output``; returns the path."""
+    plt = _plt()
+    output = Path(output)
+    if output.parent != Path(""):
+        output.parent.mkdir(parents=True, exist_ok=True)
+    fig = heatmap_figure(problem, scores, title=title, **kwargs)
     try:
         fig.savefig(output, dpi=dpi, bbox_inches="tight", format="png")
     finally:

@@ -174,9 +174,9 @@ def test_resting_manipulator_and_fixture_are_bodies():
     state = state_of(problem, b0=(3.0, 2.5, 0.0), fix=(6.0, 2.5, 0.0))
     outcome = simulate(problem, state, push_east(3.0, 2.5, 4.0))
     assert outcome.ok
-    # the fixture is movable: the block pushes it along and ends touching it
+    # the fixture is clamped: the block is pushed against it and ends touching it, unmoved
     b0, fix = outcome.state.pose("b0"), outcome.state.pose("fix")
-    assert fix[0] > 6.5
+    assert fix == (6.0, 2.5, 0.0)
     assert fix[0] - 0.25 - (b0[0] + 0.5) == pytest.approx(0.0, abs=0.02)
     # a manipulator lying on the table is an obstacle to another one's push
     state2 = state_of(problem, b0=(3.0, 2.5, 0.0), paddle2=(5.0, 2.5, EAST))

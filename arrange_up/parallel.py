@@ -1,0 +1,346 @@
+"""Running independent simulation batches in parallel: local processes or a Dask cluster.
+
+Rollouts of a plan (:mod:`arrange_up.evaluate`), and later other embarrassingly parallel
+batches (training data for learned transition models, benchmarks), go through one small
+abstraction, a :class:`Runner`::
+
+    runner = get_runner("local", workers=2)        # or get_runner("dask", scheduler="tcp://…")
+    for item, result in runner.map(fn, items, chunksize=25):
+        ...                                        # in completion order, as chunks finish
+
+``fn`` takes one item and returns one result; it and the items must be picklable (a module-level
+function, or a :func:`functools.partial` of one). Items are sent in chunks of ``chunksize`` (one
+task per chunk) to amortise the per-task overhead; every chunk's ``(item, result)`` pairs are
+yielded as soon as that chunk finishes, so callers can record results at once and show
+progress. Results arrive in completion order, not item order: callers that need determinism
+make each result depend on its item only (the rollouts seed each one from ``(seed, index)``).
+
+Backends
+========
+* ``"local"`` with one worker: :class:`SerialRunner` runs everything in this process, one item
+  at a time (no pool, no pickling; each result is yielded as it is computed).
+* ``"local"`` with more: :class:`LocalRunner`, joblib's loky process pool
+  (:func:`local_executor`, ``joblib.externals.loky.get_reusable_executor``), fed chunk by chunk
+  (at most two tasks per worker in flight) and read with ``concurrent.futures.wait``. loky keeps
+  one executor per process and hands the same one to every caller that asks with the same
+  arguments, so only the first batch pays the pool's start-up (~60 ms plus about a second for
+  the workers' imports); the particle semantics and fixture repair share it. Idle workers are
+  reaped after :data:`IDLE_TIMEOUT` seconds and respawned by the next batch. Interrupting a
+  batch cancels its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
+  executor wrapper cannot take over an executor that ``get_reusable_executor`` created, so
+  mixing the two in one process fails with ``AttributeError: _temp_folder_manager``.)
+* ``"dask"``: :class:`DaskRunner`, a ``dask.distributed`` client. With no ``scheduler`` address
+  it starts (once per process and worker count, kept for later batches, closed at exit) a
+  ``LocalCluster(n_workers=workers, threads_per_worker=1, processes=True)``; with an address it
+  connects ``Client(scheduler)`` to an existing cluster, whose workers must have arrange-up
+  installed. Tasks go directly through the client (``submit`` and ``as_completed``), not
+  through joblib's Dask backend: the function (which carries the problem and plan) is
+  scattered to every worker once, the number of tasks in flight is bounded (four per worker),
+  and an interrupted batch cancels its queued tasks without tearing the cluster down. dask is
+  imported only here, and only when this backend is asked for; without it
+  :class:`BackendUnavailableError` says to ``pip install "arrange-up[dask]"``.
+
+:func:`get_runner` caches runners, so repeated batches in one process reuse the same pool or
+cluster; :func:`shutdown` closes the cached Dask clients and clusters (the local pool is
+joblib's and reaps itself).
+"""
+
+from __future__ import annotations
+
+import atexit
+import math
+import os
+import threading
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from itertools import islice
+from typing import Any, TypeVar
+
+__all__ = [
+    "BACKENDS",
+    "BackendUnavailableError",
+    "DaskRunner",
+    "LocalRunner",
+    "Runner",
+    "SerialRunner",
+    "available_cores",
+    "get_runner",
+    "local_executor",
+    "shutdown",
+]
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+BACKENDS: tuple[str, ...] = ("local", "dask")
+DASK_INSTALL_HINT = 'pip install "arrange-up[dask]"'
+
+
+class BackendUnavailableError(RuntimeError):
+    """A backend was asked for whose libraries are not installed (or that cannot be reached)."""
+
+
+def available_cores() -> int:
+    """Cores this process may run on (``os.sched_getaffinity``), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return os.cpu_count() or 1
+
+
+def _chunks(items: Iterable[T], size: int) -> Iterator[list[T]]:
+    iterator = iter(items)
+    while chunk := list(islice(iterator, size)):
+        yield chunk
+
+
+def _apply_chunk(fn: Callable[[T], R], chunk: Sequence[T]) -> list[tuple[T, R]]:
+    """Worker side: ``fn`` over one chunk, keeping each item beside its result."""
+    return [(item, fn(item)) for item in chunk]
+
+
+class Runner:
+    """Maps a function over items, in chunks, yielding ``(item, result)`` as chunks finish.
+
+    ``backend`` names the backend and ``workers`` the number of tasks it runs at once.
+    """
+
+    backend: str = ""
+    workers: int = 1
+
+    def map(
+        self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
+    ) -> Iterator[tuple[T, R]]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Release what this runner holds (nothing by default)."""
+
+    def describe(self) -> str:
+        return f"{self.backend}, {self.workers} worker{'s' if self.workers != 1 else ''}"
+
+
+def _check_chunksize(chunksize: int) -> int:
+    if not isinstance(chunksize, int) or isinstance(chunksize, bool) or chunksize < 1:
+        raise ValueError(f"chunksize must be a positive integer, got {chunksize!r}")
+    return chunksize
+
+
+class SerialRunner(Runner):
+    """Everything in this process, item by item (``workers=1``)."""
+
+    backend = "local"
+    workers = 1
+
+    def map(
+        self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
+    ) -> Iterator[tuple[T, R]]:
+        _check_chunksize(chunksize)
+        for item in items:
+            yield item, fn(item)
+
+
+#: Idle seconds after which loky reaps a pool's workers. It is loky's default on purpose: loky
+#: keeps ONE executor per process and rebuilds it whenever a caller passes other arguments, so
+#: every user of the local pool (the particle semantics, fixture repair, the rollouts) must ask
+#: for it with the same arguments: through :func:`local_executor`, or as
+#: ``get_reusable_executor(max_workers=n)``.
+IDLE_TIMEOUT = 10
+
+
+def local_executor(workers: int) -> Any:
+    """The process's shared loky executor with ``workers`` processes (started on first use,
+    reused afterwards; resized, not restarted, when the count changes)."""
+    from joblib.externals.loky import get_reusable_executor
+
+    return get_reusable_executor(max_workers=workers, timeout=IDLE_TIMEOUT)
+
+
+class LocalRunner(Runner):
+    """Local worker processes: joblib's loky executor, shared and reused across batches."""
+
+    backend = "local"
+
+    def __init__(self, workers: int) -> None:
+        if workers < 2:
+            raise ValueError("LocalRunner needs at least 2 workers; use SerialRunner for 1")
+        self.workers = workers
+
+    def map(
+        self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
+    ) -> Iterator[tuple[T, R]]:
+        from concurrent.futures import FIRST_COMPLETED, wait
+
+        _check_chunksize(chunksize)
+        executor = local_executor(self.workers)
+        chunks = _chunks(items, chunksize)
+        pending: set[Any] = set()
+
+        def submit(chunk: list[T]) -> None:
+            pending.add(executor.submit(_apply_chunk, fn, chunk))
+
+        # at most two tasks per worker in flight: results stream back in completion order
+        # and an interruption has little queued work to cancel
+        for chunk in islice(chunks, 2 * self.workers):
+            submit(chunk)
+        try:
+            while pending:
+                done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in done:
+                    pending.discard(future)
+                    pairs = future.result()
+                    following = next(chunks, None)
+                    if following is not None:
+                        submit(following)
+                    yield from pairs
+        finally:
+            # interrupted: drop the queued tasks (running ones finish and are discarded); the
+            # pool stays up for the next batch
+            for future in pending:
+                future.cancel()
+
+
+class DaskRunner(Runner):
+    """A ``dask.distributed`` client: a LocalCluster of its own, or an existing scheduler."""
+
+    backend = "dask"
+
+    def __init__(self, workers: int | None = None, scheduler: str | None = None) -> None:
+        distributed = _import_distributed()
+        self.scheduler = scheduler
+        self._cluster = None
+        if scheduler is None:
+            import logging
+
+            n = workers or available_cores()
+            self._cluster = distributed.LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,  # no fixed port: the machine may be shared
+                silence_logs=logging.ERROR,
+            )
+            try:
+                self.client = distributed.Client(self._cluster)
+            except BaseException:
+                self._cluster.close()
+                raise
+        else:
+            try:
+                self.client = distributed.Client(scheduler, timeout="10s")
+            except (OSError, TimeoutError) as error:
+                raise BackendUnavailableError(
+                    f"cannot reach the Dask scheduler at {scheduler!r}: {error}"
+                ) from None
+        info = self.client.scheduler_info()
+        threads = sum(w.get("nthreads", 1) for w in info.get("workers", {}).values())
+        self.workers = max(1, threads)
+
+    def map(
+        self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
+    ) -> Iterator[tuple[T, R]]:
+        from distributed import as_completed
+
+        _check_chunksize(chunksize)
+        client = self.client
+        # The function carries the problem and the plan: send it to every worker once.
+        fn_future = client.scatter(fn, broadcast=True, hash=False)
+        chunks = _chunks(items, chunksize)
+        in_flight: set[Any] = set()
+
+        def submit(chunk: list[T]) -> Any:
+            future = client.submit(_apply_chunk, fn_future, chunk, pure=False)
+            in_flight.add(future)
+            return future
+
+        # four tasks per worker in flight hide the scheduler's round trip (~5-10 ms a task)
+        queue = as_completed([submit(c) for c in islice(chunks, 4 * self.workers)])
+        try:
+            for future in queue:
+                in_flight.discard(future)
+                pairs = future.result()
+                following = next(chunks, None)
+                if following is not None:
+                    queue.add(submit(following))
+                yield from pairs
+        finally:
+            if in_flight:  # interrupted: drop what is queued, keep the cluster
+                client.cancel(list(in_flight))
+
+    def close(self) -> None:
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+    def describe(self) -> str:
+        where = self.scheduler or "LocalCluster"
+        return f"dask ({where}), {self.workers} worker{'s' if self.workers != 1 else ''}"
+
+
+def _import_distributed() -> Any:
+    try:
+        import distributed
+    except ImportError as error:
+        raise BackendUnavailableError(
+            f"the dask backend needs dask.distributed, which is not installed ({error}); "
+            f"install it with: {DASK_INSTALL_HINT}"
+        ) from None
+    return distributed
+
+
+_RUNNERS: dict[tuple[Any, ...], Runner] = {}
+_LOCK = threading.Lock()
+
+
+def get_runner(
+    backend: str = "local", workers: int | None = None, scheduler: str | None = None
+) -> Runner:
+    """The runner of a backend, cached per process (pools and clusters live across batches).
+
+    ``workers=None`` means every core this process may use (:func:`available_cores`); for
+    ``"dask"`` with a ``scheduler`` address the cluster's own workers are used and ``workers``
+    is ignored. Raises ``ValueError`` for an unknown backend or a bad worker count,
+    :class:`BackendUnavailableError` when dask is missing or the scheduler cannot be reached.
+    """
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
+    if workers is not None and (
+        not isinstance(workers, int) or isinstance(workers, bool) or workers < 1
+    ):
+        raise ValueError(f"workers must be a positive integer, got {workers!r}")
+    if scheduler is not None and backend != "dask":
+        raise ValueError("a scheduler address needs the dask backend")
+    if backend == "local":
+        n = workers or available_cores()
+        return SerialRunner() if n == 1 else LocalRunner(n)
+    key = ("dask", scheduler) if scheduler else ("dask", workers or available_cores())
+    with _LOCK:
+        runner = _RUNNERS.get(key)
+        if runner is None:
+            runner = _RUNNERS[key] = DaskRunner(workers=workers, scheduler=scheduler)
+        return runner
+
+
+def shutdown() -> None:
+    """Close every cached Dask client and cluster (registered to run at exit)."""
+    with _LOCK:
+        runners = list(_RUNNERS.values())
+        _RUNNERS.clear()
+    for runner in runners:
+        try:
+            runner.close()
+        except Exception:  # pragma: no cover - best effort at exit
+            pass
+
+
+atexit.register(shutdown)
+
+
+def auto_chunksize(n_items: int, workers: int, *, most: int = 25) -> int:
+    """A chunk size giving each worker about four tasks, between 1 and ``most``.
+
+    Several tasks per worker balance the load at the end of a batch; at most ``most`` items per
+    task keep results (and progress) flowing and bound what an interrupted batch loses.
+    """
+    if n_items <= 0:
+        return 1
+    return max(1, min(most, math.ceil(n_items / (4 * max(1, workers)))))

@@ -1,0 +1,112 @@
+"""Tests of arrange_up.parallel: serial, local-process and Dask runners."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import pytest
+
+from arrange_up import parallel
+from arrange_up.parallel import (
+    BackendUnavailableError,
+    LocalRunner,
+    SerialRunner,
+    auto_chunksize,
+    get_runner,
+)
+
+
+def _square(x: int) -> int:
+    return x * x
+
+
+def _pid(_: int) -> int:
+    time.sleep(0.01)
+    return os.getpid()
+
+
+def _boom(x: int) -> int:
+    if x == 5:
+        raise RuntimeError("rollout 5 broke")
+    return x
+
+
+def test_serial_runner_maps_in_order():
+    runner = get_runner("local", workers=1)
+    assert isinstance(runner, SerialRunner) and runner.workers == 1
+    assert list(runner.map(_square, range(5), chunksize=3)) == [(i, i * i) for i in range(5)]
+
+
+def test_local_runner_yields_every_item_once_and_reuses_its_pool():
+    runner = get_runner("local", workers=2)
+    assert isinstance(runner, LocalRunner) and runner.workers == 2
+    pairs = list(runner.map(_square, range(23), chunksize=4))
+    assert sorted(pairs) == [(i, i * i) for i in range(23)]
+    first = {pid for _, pid in runner.map(_pid, range(20), chunksize=2)}
+    second = {pid for _, pid in get_runner("local", workers=2).map(_pid, range(20), chunksize=2)}
+    assert os.getpid() not in first
+    assert second == first  # the same worker processes: no new start-up
+
+
+def test_the_pool_is_shared_with_the_planners_executor():
+    # the particle semantics and fixture repair take loky's executor directly
+    from joblib.externals.loky import get_reusable_executor
+
+    theirs = get_reusable_executor(max_workers=2)
+    before = set(theirs.map(_pid, range(8)))
+    ours = {pid for _, pid in get_runner("local", workers=2).map(_pid, range(8), chunksize=1)}
+    after = set(get_reusable_executor(max_workers=2).map(_pid, range(8)))
+    assert before == ours == after
+    assert parallel.local_executor(2) is theirs
+
+
+def test_errors_in_workers_reach_the_caller():
+    with pytest.raises(RuntimeError, match="rollout 5 broke"):
+        list(get_runner("local", workers=2).map(_boom, range(10), chunksize=2))
+
+
+def test_bad_arguments():
+    with pytest.raises(ValueError, match="unknown backend"):
+        get_runner("cloud")
+    with pytest.raises(ValueError, match="workers"):
+        get_runner("local", workers=0)
+    with pytest.raises(ValueError, match="needs the dask backend"):
+        get_runner("local", scheduler="tcp://localhost:8786")
+    with pytest.raises(ValueError, match="chunksize"):
+        list(SerialRunner().map(_square, [1], chunksize=0))
+    assert parallel.available_cores() >= 1
+
+
+def test_auto_chunksize():
+    assert auto_chunksize(1000, 2) == 25
+    assert auto_chunksize(20, 2) == 3
+    assert auto_chunksize(3, 8) == 1
+    assert auto_chunksize(0, 2) == 1
+
+
+def test_missing_dask_gives_an_install_hint(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(BackendUnavailableError, match=r'pip install "arrange-up\[dask\]"'):
+        parallel.DaskRunner(workers=2)
+
+
+def test_dask_local_cluster_matches_local_processes():
+    pytest.importorskip("distributed")
+    from arrange_up.domains import load
+    from arrange_up.evaluate import evaluate_plan
+    from arrange_up.planner import plan
+
+    problem = load("blocks-2")
+    actions = plan(problem, semantics="deterministic", seed=0).actions
+    try:
+        runner = get_runner("dask", workers=2)
+        assert runner.workers == 2 and get_runner("dask", workers=2) is runner
+        assert sorted(runner.map(_square, range(7), chunksize=2)) == [(i, i * i) for i in range(7)]
+        on_dask = evaluate_plan(problem, actions, rollouts=20, seed=0, backend="dask", workers=2)
+    finally:
+        parallel.shutdown()
+    local = evaluate_plan(problem, actions, rollouts=20, seed=0, workers=2)
+    assert on_dask == local
+    assert on_dask.backend == "dask" and on_dask.workers == 2
