@@ -82,8 +82,9 @@ def test_relative_goal_fluents_and_wrapped_initial_angles():
     assert "obstacle" not in _names(up.user_types)
     values = {str(k): v.constant_value() for k, v in up.explicit_initial_values.items()}
     # T at (3.5, 8, 0), Z at (8.5, 4, 90 deg); a Z looks the same after a half turn, so its
-    # angle is stored in [-90, 90): -90. Z in T's frame: (5, -4), 90 deg around the target 90.
-    assert values["theta(Z)"] == -90
+    # angle is stored in the half-open period centred on its start angle: [0, 180) holds 90.
+    # Z in T's frame: (5, -4), 90 deg around the target 90.
+    assert values["theta(Z)"] == 90
     assert (values["rel_x(Z)"], values["rel_y(Z)"], values["rel_theta(Z)"]) == (5, -4, 90)
     assert all(isinstance(v, Fraction | bool) for v in values.values())
     # on_table of the reference and of the part, two bounds on each relative coordinate
