@@ -214,7 +214,7 @@ def search_table(
                             "seconds": round(time.perf_counter() - start, 3),
                         }
                     )
-    plot_search_table(path, path.with_suffix(".png"))
+    plot_search_table(path, Path(output_dir) / f"search-table-{semantics}.png", semantics)
     return path
 
 
@@ -254,11 +254,12 @@ def plot_transition_comparison(csv_path: Path, png_path: Path) -> Path:
     return png_path
 
 
-def plot_search_table(csv_path: Path, png_path: Path) -> Path:
-    """Nodes expanded per problem for each search type and domination setting (log scale)."""
+def plot_search_table(csv_path: Path, png_path: Path, semantics: str) -> Path:
+    """Nodes expanded per problem for each search type and domination setting (log scale),
+    for the rows of one semantics."""
     from arrange_up.render import _plt
 
-    rows = _read(csv_path)
+    rows = [r for r in _read(csv_path) if r["semantics"] == semantics]
     problems = list(dict.fromkeys(r["problem"] for r in rows))
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 4))
@@ -278,7 +279,7 @@ def plot_search_table(csv_path: Path, png_path: Path) -> Path:
             ax.plot(problems, ys, style, marker="o", label=f"{label}, domination {domination}")
     ax.set_yscale("log")
     ax.set_ylabel("nodes expanded (solved runs)")
-    ax.set_title("search table (Table 3.1)", fontsize=10)
+    ax.set_title(f"search table (Table 3.1), {semantics} transitions", fontsize=10)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(png_path, dpi=120)

@@ -39,6 +39,7 @@ SemanticsFactory = Callable[..., Semantics]
 _REGISTRY: dict[str, tuple[str, str]] = {
     "deterministic": ("arrange_up.transitions.particles", "DeterministicSemantics"),
     "particles": ("arrange_up.transitions.particles", "ParticleSemantics"),
+    "cbst": ("arrange_up.transitions.cbst", "CBSTSemantics"),
 }
 
 

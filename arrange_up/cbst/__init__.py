@@ -1,0 +1,41 @@
+"""CBST: composable learned belief-state transitions with contact graphs (thesis §3.2).
+
+* :mod:`~arrange_up.cbst.frame`: the canonical "push toward +u" frame (one implementation for
+  the four axis directions).
+* :mod:`~arrange_up.cbst.contact_graph`: MAKECG, maximal paths and the predictability rules.
+* :mod:`~arrange_up.cbst.features`: PREDICT's features, targets and validity domain.
+* :mod:`~arrange_up.cbst.data`: the seeded, parallel, resumable training-data generator.
+* :mod:`~arrange_up.cbst.fast_forest`: a random forest as flat arrays, evaluated vectorised.
+* :mod:`~arrange_up.cbst.model`: :class:`CBSTRegressor`, tuning, storage, :func:`train_cbst`.
+
+The semantics itself is :class:`arrange_up.transitions.cbst.CBSTSemantics`
+(``plan(problem, semantics="cbst")``); see ``docs/cbst.md``. Importing this package is cheap:
+scikit-learn and networkx load with the modules that use them.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+__all__ = ["CBSTRegressor", "generate_dataset", "load_model", "train_cbst"]
+
+if TYPE_CHECKING:  # pragma: no cover
+    from arrange_up.cbst.data import generate_dataset
+    from arrange_up.cbst.model import CBSTRegressor, load_model, train_cbst
+
+_LAZY = {
+    "CBSTRegressor": "arrange_up.cbst.model",
+    "load_model": "arrange_up.cbst.model",
+    "train_cbst": "arrange_up.cbst.model",
+    "generate_dataset": "arrange_up.cbst.data",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'arrange_up.cbst' has no attribute {name!r}")

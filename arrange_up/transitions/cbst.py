@@ -1,0 +1,273 @@
+"""Composable belief-state transitions (CBST, thesis §3.2) on factored interval beliefs.
+
+Beliefs are :class:`~arrange_up.belief.IntervalBelief`: one box ``center ± half`` in
+``(x, y, theta)`` per object on the table, in the problem's object order, rounded to 1e-6
+(angles wrapped into each object's symmetry period around its reference) so that equal
+outcomes compare and hash equal and the search dedupes them.
+
+* **initial belief**: the problem's initial poses and uncertainties.
+* **place**: the object's box is the commanded pose ± the place uncertainty.
+* **pick**: the object is removed.
+* **push**: the belief is mapped into the canonical "push toward +u" frame
+  (:class:`~arrange_up.cbst.frame.CanonicalFrame`), the contact graph decides what moves
+  (:func:`~arrange_up.cbst.contact_graph.analyse_push`), and every object of the compressed
+  train(s) gets its new box from the learned PREDICT (:func:`~arrange_up.cbst.model.load_model`)
+  composed from the wall back toward the paddle (PUSHTRANSOBJ): an object at depth ``k``
+  (``k`` objects from the wall, itself included) ends with ``u`` in
+  ``[x_max - dx, x_max + max(slip, allowance_k)]``, ``x_max = wall - (k - 1/2) d`` (the
+  thesis's ``b[next].x - d`` with ``next`` flush and as far forward as possible), ``v`` in
+  ``v ± dy`` about its unchanged centre (clipped to the walls beside the push), and angle
+  ``0 ± dth`` in the canonical frame. A *grazed* object (already flush, touched at most by
+  a corner of a neighbouring row sliding past) keeps its box, extended forward to ``x_max``
+  plus the slop allowance and sideways by the grazer's largest overlap. Objects the push
+  cannot reach are unchanged; a push
+  whose paddle sweep touches nothing returns the belief itself.
+
+The features of every object come from the belief *before* the push (as in the training
+data), so all of a push's predictions are one batched call of the fast forest.
+
+A push returns ``None`` (no prediction) whenever the contact graph says so (see
+:mod:`arrange_up.cbst.contact_graph`), when the push is not axis-aligned, when the
+manipulator or a pushed object is not the paddle/block the model was trained on, when a
+feature lies outside the training domain, or when the model predicts that the train may
+buckle (predicted ``slip`` above :data:`~arrange_up.cbst.features.BUCKLE_LIMIT`).
+``reasons`` counts the reasons, for diagnostics.
+
+``simulations`` counts model predictions: one per feature row evaluated (one PREDICT of the
+thesis; an object with several certain neighbours on either side takes one per pair).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+
+from arrange_up.belief import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
+from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
+from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
+from arrange_up.cbst.frame import CanonicalFrame
+from arrange_up.collision import CollisionChecker
+from arrange_up.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
+from arrange_up.world import Action, Pick, Place, Push
+
+__all__ = ["CBSTSemantics"]
+
+#: Shapes and sizes are compared with this tolerance (inches).
+_SIZE_TOL = 1e-6
+
+
+def _r(value: float) -> float:
+    return round(float(value), 6) + 0.0
+
+
+class CBSTSemantics:
+    """CBST over interval beliefs (see the module docstring).
+
+    ``particles`` is 2: the planner sees an interval belief as its two corner
+    pseudo-particles. ``seed`` and ``workers`` are accepted for the registry's signature and
+    unused (predictions are deterministic and take microseconds). ``model`` names the
+    learned model (a shipped name or a card path).
+    """
+
+    name = "cbst"
+
+    def __init__(
+        self,
+        problem: ArrangementProblem,
+        *,
+        particles: int = 2,
+        seed: int = 0,
+        workers: int = 1,
+        model: str = "default",
+    ) -> None:
+        from arrange_up.cbst.model import load_model
+
+        self.problem = problem
+        self.particles = 2
+        self.seed = seed
+        self.workers = workers
+        self.simulations = 0
+        self.reasons: Counter[str] = Counter()
+        self.model = load_model(model)
+        card = self.model.card_
+        self.block_size = float(card["block_size"])
+        self.paddle_size = tuple(float(v) for v in card["paddle_size"])
+        self.domain = self.model.domain_
+        allowance = {int(k): float(v) for k, v in card["overshoot_allowance"].items()}
+        self._allowance = allowance
+        self._allowance_rate = max((v / k for k, v in allowance.items()), default=0.0)
+        self.angles = AngleFrame.of(problem)
+        self.checker = CollisionChecker(problem)
+        self._order = {spec.name: i for i, spec in enumerate(problem.objects)}
+        self._block = {spec.name: self._is_block(spec) for spec in problem.objects}
+
+    # -- what the model applies to ------------------------------------------------------------
+    def _is_block(self, spec) -> bool:
+        if spec.kind not in (ObjectKind.PART, ObjectKind.FIXTURE) or spec.shape.box is None:
+            return False
+        w, h = spec.shape.box
+        d = self.block_size
+        return abs(w - d) <= _SIZE_TOL and abs(h - d) <= _SIZE_TOL
+
+    def _is_paddle(self, spec) -> bool:
+        if spec.shape.box is None:
+            return False
+        a, b = sorted(spec.shape.box, reverse=True)
+        length, thickness = self.paddle_size
+        return abs(a - length) <= _SIZE_TOL and abs(b - thickness) <= _SIZE_TOL
+
+    def allowance(self, depth: int) -> float:
+        """Contact-slop allowance (inches) beyond ``x_max`` for an object at ``depth``:
+        measured per depth in the training data, extrapolated linearly beyond it."""
+        if depth in self._allowance:
+            return self._allowance[depth]
+        return depth * self._allowance_rate
+
+    # -- beliefs ------------------------------------------------------------------------------
+    def _interval(self, name: str, center: Pose, half: HalfWidths) -> ObjectInterval:
+        theta = wrap_angle(center[2], self.angles.reference[name], self.angles.period[name])
+        return ObjectInterval(
+            (_r(center[0]), _r(center[1]), _r(theta)),
+            (_r(abs(half[0])), _r(abs(half[1])), _r(abs(half[2]))),
+        )
+
+    def _belief(self, objects: dict[str, ObjectInterval]) -> IntervalBelief:
+        return IntervalBelief(tuple(sorted(objects.items(), key=lambda kv: self._order[kv[0]])))
+
+    def initial_belief(self) -> IntervalBelief:
+        return self._belief(
+            {e.name: self._interval(e.name, e.pose, e.uncertainty) for e in self.problem.initial}
+        )
+
+    def apply(self, belief: IntervalBelief, action: Action) -> IntervalBelief | None:
+        if isinstance(action, Push):
+            return self._push(belief, action)
+        objects = dict(belief.objects)
+        if isinstance(action, Place):
+            objects[action.obj] = self._interval(
+                action.obj, action.pose, self.problem.uncertainty.place
+            )
+        elif isinstance(action, Pick):
+            objects.pop(action.obj, None)
+        else:
+            raise TypeError(f"not an action: {action!r}")
+        return self._belief(objects)
+
+    def _refuse(self, reason: str) -> None:
+        self.reasons[reason] += 1
+        return None
+
+    # -- push ---------------------------------------------------------------------------------
+    def _push(self, belief: IntervalBelief, push: Push) -> IntervalBelief | None:
+        problem = self.problem
+        spec = problem.object(push.manipulator)
+        px, py = spec.push_direction
+        c, s = math.cos(push.pose[2]), math.sin(push.pose[2])
+        frame = CanonicalFrame.of_vector(c * px - s * py, s * px + c * py)
+        if frame is None:
+            return self._refuse("the push is not axis-aligned")
+        d = self.block_size
+        nodes = []
+        for name, iv in belief.objects:
+            center = frame.pose_to(iv.center)
+            # The model was trained on square blocks with centre angle 0 (mod 90 degrees).
+            aligned = abs(wrap_angle(center[2], 0.0, 0.5 * math.pi)) <= 1e-6
+            nodes.append(
+                Node(
+                    name,
+                    center,
+                    frame.half_to(iv.half),
+                    frame.box_to(self.checker.shadow_box(name, iv.center, iv.half)),
+                    block=self._block.get(name, False) and aligned,
+                )
+            )
+        push_unc = problem.uncertainty.push
+        xmin, ymin, xmax, ymax = spec.shape.extent
+        along_y = abs(py) > abs(px)  # the push direction in the manipulator's own frame
+        length, thickness = (xmax - xmin, ymax - ymin) if along_y else (ymax - ymin, xmax - xmin)
+        paddle = Paddle(
+            center=frame.pose_to(push.pose),
+            half=frame.half_to(push_unc),
+            box=frame.box_to(self.checker.shadow_box(push.manipulator, push.pose, push_unc)),
+            length=length,
+            thickness=thickness,
+            travel=float(push.distance),
+        )
+        table = frame.table_box(problem.table.size)
+        wall = table[2] if frame.wall_ahead in problem.table.walls else None
+        obstacles = [frame.box_to(box) for box in self.checker.obstacle_boxes.values()]
+        structure = analyse_push(paddle, nodes, wall=wall, block_size=d, obstacles=obstacles)
+        if structure.kind == "unchanged":
+            return belief
+        if structure.kind == "none":
+            return self._refuse(structure.reason)
+        if not self._is_paddle(spec):
+            return self._refuse(f"{push.manipulator!r} is not the paddle the model was trained on")
+        assert wall is not None
+        by_name = {node.name: node for node in nodes}
+
+        def neighbour(key):
+            if key is ROBOT:
+                return paddle.half, paddle.center[1], False
+            node = by_name[key]
+            return node.half, node.center[1], True
+
+        rows, owner = [], []
+        for k, member in enumerate(structure.members):
+            if member.grazed:
+                continue
+            cur = by_name[member.name]
+            for prev in member.prevs:
+                p_half, p_v, p_obj = neighbour(prev)
+                for nxt in member.nexts:
+                    n_half, n_v = (None, None) if nxt is WALL else neighbour(nxt)[:2]
+                    rows.append(
+                        feature_row(p_half, p_v, p_obj, cur.half, cur.center[1], n_half, n_v)
+                    )
+                    owner.append(k)
+        X = np.asarray(rows, dtype=float).reshape(-1, 12)
+        if not bool(np.all(self.domain.contains(X))):
+            return self._refuse("a pushed object's belief is outside the model's training domain")
+        pred = np.maximum(self.model.predict_rows(X), 0.0) if len(X) else np.zeros((0, 4))
+        self.simulations += len(rows)
+        owner_arr = np.asarray(owner, dtype=int)
+        low_wall, high_wall = frame.side_walls
+        v_min = table[1] + 0.5 * d if low_wall in problem.table.walls else -math.inf
+        v_max = table[3] - 0.5 * d if high_wall in problem.table.walls else math.inf
+        objects = dict(belief.objects)
+        for k, member in enumerate(structure.members):
+            cur = by_name[member.name]
+            if member.grazed:
+                # Left alone or touched by a corner sliding past: it stays where it may be,
+                # may be nudged forward up to x_max (plus slop) and sideways by the overlap.
+                x_max = wall - (member.depth - 0.5) * d
+                u_low = cur.center[0] - cur.half[0]
+                u_high = max(cur.center[0] + cur.half[0], x_max + self.allowance(member.depth))
+                v_low = max(cur.center[1] - cur.half[1] - member.graze, v_min)
+                v_high = min(cur.center[1] + cur.half[1] + member.graze, v_max)
+                canonical = (0.5 * (u_low + u_high), 0.5 * (v_low + v_high), cur.center[2])
+                half = frame.half_from(
+                    (0.5 * (u_high - u_low), 0.5 * (v_high - v_low), cur.half[2])
+                )
+                objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
+                continue
+            dx, dy, dth, slip = pred[owner_arr == k].max(axis=0)[:4]
+            if slip > BUCKLE_LIMIT:
+                return self._refuse("the model predicts that the train may buckle")
+            x_max = wall - (member.depth - 0.5) * d
+            u_low, u_high = x_max - dx, x_max + max(slip, self.allowance(member.depth))
+            v = cur.center[1]
+            v_low, v_high = max(v - dy, v_min), min(v + dy, v_max)
+            if v_low > v_high:
+                return self._refuse(f"{member.name!r} would end outside the table")
+            canonical = (0.5 * (u_low + u_high), 0.5 * (v_low + v_high), 0.0)
+            half = frame.half_from(
+                (0.5 * (u_high - u_low), 0.5 * (v_high - v_low), math.radians(dth))
+            )
+            objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
+        return self._belief(objects)
+
+    def close(self) -> None:
+        """Nothing to release."""

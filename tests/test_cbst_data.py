@@ -1,0 +1,75 @@
+"""CBST training data: feature layout, reproducibility, resuming."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from arrange_up.cbst.data import generate_dataset, generate_example, load_dataset
+from arrange_up.cbst.features import FEATURE_NAMES, TARGET_NAMES, Domain, contact_type
+
+ROLLOUTS = 6  # tiny: these tests check plumbing, not statistics
+
+
+def test_contact_type_encoding():
+    assert [contact_type(p, n) for p in (False, True) for n in (False, True)] == [0, 1, 2, 3]
+
+
+def test_example_layout_and_targets():
+    record = generate_example(3, seed=11, rollouts=ROLLOUTS)
+    n = record["blocks"]
+    assert 1 <= n <= 3 and record["ok"] + sum(record["failed"].values()) == ROLLOUTS
+    X = np.asarray(record["features"])
+    y = np.asarray(record["targets"])
+    assert X.shape == (n, len(FEATURE_NAMES)) and y.shape == (n, len(TARGET_NAMES))
+    # Paddle side first: ct says "previous is the paddle" for row 0 only; the last row's next
+    # is the wall (zero half-widths and offset).
+    assert X[0, 11] in (0, 1) and np.all(X[1:, 11] >= 2)
+    assert X[-1, 11] in (0, 2) and np.all(X[-1, 6:9] == 0) and X[-1, 10] == 0
+    # Consecutive rows share beliefs: row j's current block is row j+1's previous one.
+    for j in range(n - 1):
+        assert np.allclose(X[j, 3:6], X[j + 1, 0:3]) and np.isclose(X[j, 10], -X[j + 1, 9])
+    assert Domain().contains(X).all()
+    assert np.all(y[:, 1:] >= 0)  # dy, dth, slip are magnitudes
+    assert np.all(y[:, 0] > -0.05)  # dx: x_max is the flush position, up to contact slop
+
+
+def test_example_depends_only_on_seed_and_index():
+    a = generate_example(5, seed=2, rollouts=ROLLOUTS)
+    b = generate_example(5, seed=2, rollouts=ROLLOUTS)
+    c = generate_example(6, seed=2, rollouts=ROLLOUTS)
+    for key in ("features", "targets", "overshoot"):
+        assert a[key] == b[key]
+    assert a["features"] != c["features"]
+
+
+def test_generation_resumes_and_refuses_other_settings(tmp_path):
+    path = tmp_path / "data.jsonl"
+    calls = []
+
+    def progress(stage, done, total):
+        calls.append((stage, done, total))
+
+    first = generate_dataset(path, examples=3, rollouts=ROLLOUTS, seed=4, progress=progress)
+    assert first["computed"] == 3 and calls[-1] == ("data", 3, 3)
+    # A torn last line (an interrupted write) is dropped and recomputed.
+    with path.open("a") as fh:
+        fh.write('{"index": 99, "broken')
+    second = generate_dataset(path, examples=5, rollouts=ROLLOUTS, seed=4)
+    assert second["computed"] == 2
+    third = generate_dataset(path, examples=5, rollouts=ROLLOUTS, seed=4)
+    assert third["computed"] == 0
+    indices = sorted(json.loads(line)["index"] for line in path.read_text().splitlines())
+    assert indices == [0, 1, 2, 3, 4]
+    # Resumed data equals data generated in one go (example i depends only on (seed, i)).
+    fresh = tmp_path / "fresh.jsonl"
+    generate_dataset(fresh, examples=5, rollouts=ROLLOUTS, seed=4, workers=2, chunksize=2)
+    a, b = load_dataset(path), load_dataset(fresh)
+    assert np.array_equal(a.X, b.X) and np.array_equal(a.y, b.y)
+    assert a.examples == 5 and len(a.groups) == len(a.X)
+    with pytest.raises(ValueError, match="other parameters"):
+        generate_dataset(path, examples=5, rollouts=ROLLOUTS + 1, seed=4)
+    with pytest.raises(ValueError, match="other parameters"):
+        load_dataset(path, seed=5)
