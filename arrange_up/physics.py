@@ -644,30 +644,22 @@ def _push(
         # 2. movable bodies, in state order, with table friction
         for obj, (x, y, th) in state.poses:
             body_def = compiled.bodies[obj]
-            if body_def.kind is ObjectKind.FIXTURE:
-                # Clamped to the table (see the module docstring): a kinematic body that
-                # never moves, with no table friction to model.
-                body = lib.cpBodyNewKinematic()
-                bodies.append(body)
-                lib.cpBodySetPosition(body, (x, y))
-                lib.cpBodySetAngle(body, th)
-                lib.cpSpaceAddBody(space, body)
-                for count, verts in body_def.parts:
-                    shape = new_poly(body, count, verts, identity, 0.0)
-                    shapes.append(shape)
-                    set_friction(shape, shape_mu)
-                    add_shape(space, shape)
-                continue
+            clamped = body_def.kind is ObjectKind.FIXTURE
             rho = (
                 noise.manipulator_density
                 if body_def.kind is ObjectKind.MANIPULATOR
                 else noise.part_density
             )
             mass = rho * body_def.area
-            moment = 0.0
-            for area_i, unit_moment in body_def.part_moments:
-                moment += rho * area_i * unit_moment
-            body = lib.cpBodyNew(mass, moment)
+            if clamped:
+                # Clamped to the table (see the module docstring): a kinematic body that
+                # never moves, with no table friction to model.
+                body = lib.cpBodyNewKinematic()
+            else:
+                moment = 0.0
+                for area_i, unit_moment in body_def.part_moments:
+                    moment += rho * area_i * unit_moment
+                body = lib.cpBodyNew(mass, moment)
             bodies.append(body)
             lib.cpBodySetPosition(body, (x, y))
             lib.cpBodySetAngle(body, th)
@@ -677,6 +669,8 @@ def _push(
                 shapes.append(shape)
                 set_friction(shape, shape_mu)
                 add_shape(space, shape)
+            if clamped:
+                continue
             pivot = lib.cpPivotJointNew2(static, body, (0.0, 0.0), (0.0, 0.0))
             constraints.append(pivot)
             set_max_bias(pivot, 0.0)
