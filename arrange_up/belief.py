@@ -19,7 +19,7 @@ angle if it has one, else its initial angle if it starts on the table, else 0).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache, cached_property
 
@@ -249,9 +249,6 @@ def sample_initial_particles(
             )
     return ParticleBelief(tuple(states))
 
-
-def particles_from_states(states: Iterable[WorldState]) -> ParticleBelief:
-    return ParticleBelief(tuple(states))
 
 
 class IntervalDominanceIndex:

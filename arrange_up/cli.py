@@ -19,7 +19,6 @@ import click
 
 from arrange_up import __version__
 
-EXIT_OK = 0
 EXIT_NEGATIVE = 1
 EXIT_BAD_INPUT = 2
 

@@ -52,7 +52,6 @@ class GoalTest:
         self.reference: str | None = goal.reference
         self.targets = np.array([goal.target(p) for p in self.parts], dtype=float).reshape(-1, 3)
         tol = goal.tolerance
-        self.any_angle = tol[2] is None
         self.tolerance = np.array([tol[0], tol[1], math.inf if tol[2] is None else tol[2]])
         self.periods = np.array(
             [symmetry_period(problem.object(p).shape) for p in self.parts], dtype=float
