@@ -174,7 +174,7 @@ class ActionGenerator:
             target = self.place_target(spec.name, belief)
             if target is None:
                 continue
-            angles = (target[2],) + tuple(target[2] + a for a in self.place_angles)
+            angles = self._place_angles(target)
             for dx, dy in self.offsets[spec.name]:
                 for theta in angles:
                     pose = (target[0] + dx, target[1] + dy, theta)
@@ -189,7 +189,7 @@ class ActionGenerator:
         if target is None:
             return []
         poses = []
-        angles = (target[2],) + tuple(target[2] + a for a in self.place_angles)
+        angles = self._place_angles(target)
         for dx, dy in self.offsets[name]:
             for theta in angles:
                 pose = (target[0] + dx, target[1] + dy, theta)
@@ -198,6 +198,10 @@ class ActionGenerator:
                 ) and not self.checker.shadow_hits_fixed(name, pose, self.place_unc):
                     poses.append(pose)
         return poses
+
+    def _place_angles(self, target: Pose) -> tuple[float, ...]:
+        """The target's angle, then each ``planning.place_angles`` offset from it, once each."""
+        return tuple(dict.fromkeys((target[2],) + tuple(target[2] + a for a in self.place_angles)))
 
     def _place_ok(self, name, pose, half, on_table) -> bool:
         return self.checker.shadow_inside_table(name, pose, half) and self.checker.shadow_clear(
