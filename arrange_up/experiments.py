@@ -247,7 +247,7 @@ def plot_transition_comparison(csv_path: Path, png_path: Path) -> Path:
         ax.set_ylabel(unit)
     ax_time.set_yscale("log")
     ax_rel.set_ylim(0, 100)
-    ax_rel.legend(fontsize=7)
+    ax_rel.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     fig.savefig(png_path, dpi=120)
     plt.close(fig)
