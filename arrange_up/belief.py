@@ -250,7 +250,6 @@ def sample_initial_particles(
     return ParticleBelief(tuple(states))
 
 
-
 class IntervalDominanceIndex:
     """Dominance pruning over many beliefs at once (thesis §2.1.2), vectorised with numpy.
 
