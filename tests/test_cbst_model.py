@@ -165,9 +165,9 @@ def test_load_by_name_from_an_installed_wheel_layout(tmp_path, monkeypatch):
 
     shipped = tmp_path / "_shipped" / "semantics" / "cbst"
     shipped.mkdir(parents=True)
-    checkout = model_module._CHECKOUT_MODELS
+    source = model_module.model_dir()  # the checkout's, or the installed wheel's
     for suffix in (".json", ".npz"):
-        shutil.copy(checkout / f"default{suffix}", shipped / f"wheel-only{suffix}")
+        shutil.copy(source / f"default{suffix}", shipped / f"wheel-only{suffix}")
     card = json.loads((shipped / "wheel-only.json").read_text())
     card["arrays"]["file"] = "wheel-only.npz"
     (shipped / "wheel-only.json").write_text(json.dumps(card))
