@@ -634,6 +634,18 @@ def _push(
         lib.cpSpaceSetCollisionBias(space, s.collision_bias)
         static = lib.cpSpaceGetStaticBody(space)
 
+        def add_body(body, body_def, x: float, y: float, th: float) -> None:
+            """Put ``body`` at its pose in the space with its convex shapes (kept alive)."""
+            bodies.append(body)
+            lib.cpBodySetPosition(body, (x, y))
+            lib.cpBodySetAngle(body, th)
+            lib.cpSpaceAddBody(space, body)
+            for count, verts in body_def.parts:
+                shape = new_poly(body, count, verts, identity, 0.0)
+                shapes.append(shape)
+                set_friction(shape, shape_mu)
+                add_shape(space, shape)
+
         # 1. walls and obstacles
         for count, verts in compiled.statics:
             shape = new_poly(static, count, verts, identity, 0.0)
@@ -660,15 +672,7 @@ def _push(
                 for area_i, unit_moment in body_def.part_moments:
                     moment += rho * area_i * unit_moment
                 body = lib.cpBodyNew(mass, moment)
-            bodies.append(body)
-            lib.cpBodySetPosition(body, (x, y))
-            lib.cpBodySetAngle(body, th)
-            lib.cpSpaceAddBody(space, body)
-            for count, verts in body_def.parts:
-                shape = new_poly(body, count, verts, identity, 0.0)
-                shapes.append(shape)
-                set_friction(shape, shape_mu)
-                add_shape(space, shape)
+            add_body(body, body_def, x, y, th)
             if clamped:
                 continue
             pivot = lib.cpPivotJointNew2(static, body, (0.0, 0.0), (0.0, 0.0))
@@ -689,15 +693,7 @@ def _push(
         px, py, pth = action.pose
         px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
         paddle = lib.cpBodyNew(noise.manipulator_density * paddle_def.area, math.inf)
-        bodies.append(paddle)
-        lib.cpBodySetPosition(paddle, (px, py))
-        lib.cpBodySetAngle(paddle, pth)
-        lib.cpSpaceAddBody(space, paddle)
-        for count, verts in paddle_def.parts:
-            shape = new_poly(paddle, count, verts, identity, 0.0)
-            shapes.append(shape)
-            set_friction(shape, shape_mu)
-            add_shape(space, shape)
+        add_body(paddle, paddle_def, px, py, pth)
         ux, uy = paddle_def.push_direction
         c, sn = math.cos(pth), math.sin(pth)
         dx, dy = ux * c - uy * sn, ux * sn + uy * c
