@@ -179,6 +179,38 @@ def __getattr__(name: str) -> Any:  # PEP 562: the engine classes are built on f
 _CACHE: dict[str, Any] = {}
 
 
+def _engine_base() -> type:
+    """The shared base of arrange-up's engines (built on first use: it imports
+    unified-planning): the engine's name from the class attribute ``_NAME``, and the problem
+    kinds and plan kinds every arrange-up engine supports."""
+    if "base" not in _CACHE:
+        from unified_planning.engines import Engine
+
+        class _ArrangeUpEngine(Engine):
+            _NAME = ""
+
+            @property
+            def name(self) -> str:
+                return self._NAME
+
+            @staticmethod
+            def supported_kind() -> Any:
+                return _supported_kind()
+
+            @staticmethod
+            def supports(problem_kind: Any) -> bool:
+                return bool(problem_kind <= _supported_kind())
+
+            @staticmethod
+            def supports_plan(plan_kind: Any) -> bool:
+                from unified_planning.plans import PlanKind
+
+                return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
+
+        _CACHE["base"] = _ArrangeUpEngine
+    return _CACHE["base"]
+
+
 def _engine_class() -> type:
     if "engine" not in _CACHE:
         _CACHE["engine"] = _build_engine_class()
@@ -191,8 +223,10 @@ def _build_engine_class() -> type:
     from unified_planning.engines import Engine
     from unified_planning.engines.mixins import OneshotPlannerMixin
 
-    class ArrangeUpPlanner(Engine, OneshotPlannerMixin):
+    class ArrangeUpPlanner(_engine_base(), OneshotPlannerMixin):  # type: ignore[misc]
         """Conformant belief-space planning for arrange-up problems (see the module doc)."""
+
+        _NAME = ENGINE_NAME
 
         def __init__(
             self,
@@ -208,18 +242,6 @@ def _build_engine_class() -> type:
             self._particles = particles
             self._seed = seed
             self._max_nodes = max_nodes
-
-        @property
-        def name(self) -> str:
-            return ENGINE_NAME
-
-        @staticmethod
-        def supported_kind() -> Any:
-            return _supported_kind()
-
-        @staticmethod
-        def supports(problem_kind: Any) -> bool:
-            return bool(problem_kind <= _supported_kind())
 
         def _solve_with_params(
             self,
@@ -433,8 +455,10 @@ def _build_validator_class() -> type:
     from unified_planning.engines import Engine
     from unified_planning.engines.mixins import PlanValidatorMixin
 
-    class ArrangeUpReliability(Engine, PlanValidatorMixin):
+    class ArrangeUpReliability(_engine_base(), PlanValidatorMixin):  # type: ignore[misc]
         """Monte Carlo reliability of a plan under the problem's noise (see the module doc)."""
+
+        _NAME = VALIDATOR_NAME
 
         def __init__(
             self,
@@ -452,24 +476,6 @@ def _build_validator_class() -> type:
             self._workers = workers
             self._backend = backend
             self._scheduler = scheduler
-
-        @property
-        def name(self) -> str:
-            return VALIDATOR_NAME
-
-        @staticmethod
-        def supported_kind() -> Any:
-            return _supported_kind()
-
-        @staticmethod
-        def supports(problem_kind: Any) -> bool:
-            return bool(problem_kind <= _supported_kind())
-
-        @staticmethod
-        def supports_plan(plan_kind: Any) -> bool:
-            from unified_planning.plans import PlanKind
-
-            return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
 
         def _validate(self, problem: Any, plan: Any) -> Any:
             return _validate(self, problem, plan)
@@ -612,7 +618,7 @@ def _build_repairer_class() -> type:
     from unified_planning.engines import Engine
     from unified_planning.engines.mixins import PlanRepairerMixin
 
-    class ArrangeUpFixtureRepairer(Engine, PlanRepairerMixin):
+    class ArrangeUpFixtureRepairer(_engine_base(), PlanRepairerMixin):  # type: ignore[misc]
         """Fixture-placement plan repair (thesis ch. 4, :func:`arrange_up.repair.repair_plan`):
         ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
 
@@ -628,6 +634,8 @@ def _build_repairer_class() -> type:
         ``step_K`` (the choice made for nominal step K).
         """
 
+        _NAME = REPAIRER_NAME
+
         def __init__(
             self,
             particles: int = 150,
@@ -642,24 +650,6 @@ def _build_repairer_class() -> type:
             self._seed = seed
             self._method = method
             self._workers = workers
-
-        @property
-        def name(self) -> str:
-            return REPAIRER_NAME
-
-        @staticmethod
-        def supported_kind() -> Any:
-            return _supported_kind()
-
-        @staticmethod
-        def supports(problem_kind: Any) -> bool:
-            return bool(problem_kind <= _supported_kind())
-
-        @staticmethod
-        def supports_plan(plan_kind: Any) -> bool:
-            from unified_planning.plans import PlanKind
-
-            return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
 
         def _repair(self, problem: Any, plan: Any) -> Any:
             return _repair(self, problem, plan)
