@@ -58,6 +58,48 @@ def _read_plan_for(problem, plan_file: str):  # -> (actions, document)
     return actions, document
 
 
+def _parallel_options(what: str):
+    """The --workers, --backend and --scheduler options of commands that run batches of
+    independent simulations (``what``: rollouts, examples, ...) on local processes or Dask."""
+
+    def decorate(command):
+        for option in reversed(
+            (
+                click.option(
+                    "--workers",
+                    type=click.IntRange(1, 1024),
+                    default=None,
+                    help="Worker processes (default: all cores; 1 runs in this process).",
+                ),
+                click.option(
+                    "--backend",
+                    type=click.Choice(["local", "dask"]),
+                    default=None,
+                    help=f"Where the {what} run: local processes (default) or a Dask cluster.",
+                ),
+                click.option(
+                    "--scheduler",
+                    metavar="ADDRESS",
+                    default=None,
+                    help="Address of a running Dask scheduler (implies --backend dask); "
+                    "without it the dask backend starts a local cluster of "
+                    "--workers processes.",
+                ),
+            )
+        ):
+            command = option(command)
+        return command
+
+    return decorate
+
+
+def _backend_choice(backend: str | None, scheduler: str | None) -> str:
+    """The backend to use: a scheduler address implies dask and contradicts local."""
+    if scheduler is not None and backend == "local":
+        _fail("--scheduler: a scheduler address needs --backend dask")
+    return backend or ("dask" if scheduler is not None else "local")
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(__version__, prog_name="arrange-up")
 def main() -> None:
@@ -609,25 +651,7 @@ def _failure_lines(problem, actions, failures) -> list[str]:
     show_default=True,
     help="Rollout i draws its noise from (seed, i): equal seeds give equal results.",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 1024),
-    default=None,
-    help="Worker processes (default: all cores; 1 runs in this process).",
-)
-@click.option(
-    "--backend",
-    type=click.Choice(["local", "dask"]),
-    default=None,
-    help="Where rollouts run: local processes (default) or a Dask cluster.",
-)
-@click.option(
-    "--scheduler",
-    metavar="ADDRESS",
-    default=None,
-    help="Address of a running Dask scheduler (implies --backend dask); without it the dask "
-    "backend starts a local cluster of --workers processes.",
-)
+@_parallel_options("rollouts")
 @click.option(
     "--record",
     type=click.Path(dir_okay=False),
@@ -673,9 +697,7 @@ def evaluate(
     from arrange_up.parallel import BackendUnavailableError
     from arrange_up.problem import problem_hash
 
-    if scheduler is not None and backend == "local":
-        _fail("--scheduler: a scheduler address needs --backend dask")
-    backend = backend or ("dask" if scheduler is not None else "local")
+    backend = _backend_choice(backend, scheduler)
     loaded = _load(problem)
     actions, document = _read_plan_for(loaded, plan_file)
     this_hash = problem_hash(loaded)
@@ -963,24 +985,7 @@ def _training_progress():
     show_default=True,
     help="Example i depends only on (seed, i); also seeds the split and the forest.",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 1024),
-    default=None,
-    help="Worker processes (default: all cores; 1 runs in this process).",
-)
-@click.option(
-    "--backend",
-    type=click.Choice(["local", "dask"]),
-    default=None,
-    help="Where examples are simulated: local processes (default) or Dask.",
-)
-@click.option(
-    "--scheduler",
-    metavar="ADDRESS",
-    default=None,
-    help="Address of a running Dask scheduler (implies --backend dask).",
-)
+@_parallel_options("examples")
 @click.option(
     "--output-dir",
     type=click.Path(file_okay=False),
@@ -1024,9 +1029,7 @@ def train_cbst(
     from arrange_up.cbst.model import train_cbst as run
     from arrange_up.parallel import BackendUnavailableError
 
-    if scheduler is not None and backend == "local":
-        _fail("--scheduler: a scheduler address needs --backend dask")
-    backend = backend or ("dask" if scheduler is not None else "local")
+    backend = _backend_choice(backend, scheduler)
     update, bar = _training_progress()
     try:
         card = run(
