@@ -518,6 +518,14 @@ class _Builder:
                     f"{_suggest(key_node.value, known)}; known keys: {', '.join(known)}",
                 )
 
+    def required(self, node: _Node, key: str, expected: str) -> _Node | None:
+        """The child ``key`` of mapping ``node``; when it is missing, report "missing required
+        key; expected ``expected``" at the mapping and return None."""
+        if node.has(key):
+            return node.child(key)
+        self.error(node.missing(key), f"missing required key; expected {expected}")
+        return None
+
     def mapping(self, node: _Node, expected: str, *, null_ok: bool = False) -> bool:
         if node.is_map or (null_ok and node.is_null):
             return True
@@ -653,12 +661,10 @@ class _Builder:
             )
 
     def name(self, root: _Node) -> str | None:
-        if not root.has("name"):
-            self.error(
-                root.missing("name"), "missing required key; expected the problem's name (a string)"
-            )
+        node = self.required(root, "name", "the problem's name (a string)")
+        if node is None:
             return None
-        return self.string(root.child("name"), "the problem's name (a non-empty string)")
+        return self.string(node, "the problem's name (a non-empty string)")
 
     def description(self, root: _Node) -> str | None:
         if not root.has("description") or root.child("description").is_null:
@@ -698,13 +704,9 @@ class _Builder:
 
     # -- table ----------------------------------------------------------------------------------
     def table(self, root: _Node) -> Table | None:
-        if not root.has("table"):
-            self.error(
-                root.missing("table"),
-                "missing required key; expected {size: [width, depth], walls: [...]}",
-            )
+        node = self.required(root, "table", "{size: [width, depth], walls: [...]}")
+        if node is None:
             return None
-        node = root.child("table")
         if not self.mapping(node, "a mapping {size: [width, depth], walls: [...]}"):
             return None
         self.warn_unknown(node, ("size", "walls"), "'table'")
@@ -899,14 +901,11 @@ class _Builder:
     # -- objects --------------------------------------------------------------------------------
     def objects(self, root: _Node, shapes: dict[str, Shape | None]) -> dict[str, _Object]:
         objects: dict[str, _Object] = {}
-        if not root.has("objects"):
-            self.error(
-                root.missing("objects"),
-                "missing required key; expected a mapping from object names to "
-                "{kind: ..., shape: ...}",
-            )
+        node = self.required(
+            root, "objects", "a mapping from object names to {kind: ..., shape: ...}"
+        )
+        if node is None:
             return objects
-        node = root.child("objects")
         if not node.is_map or not node.value:
             got = "an empty mapping" if node.is_map else _describe(node.value)
             self.error(
@@ -1123,14 +1122,13 @@ class _Builder:
 
     # -- goal -----------------------------------------------------------------------------------
     def goal(self, root: _Node, objects: dict[str, _Object]) -> Goal | None:
-        if not root.has("goal"):
-            self.error(
-                root.missing("goal"),
-                "missing required key; expected a mapping with exactly one of 'poses' or "
-                "'relative', and a 'tolerance'",
-            )
+        node = self.required(
+            root,
+            "goal",
+            "a mapping with exactly one of 'poses' or 'relative', and a 'tolerance'",
+        )
+        if node is None:
             return None
-        node = root.child("goal")
         if not self.mapping(
             node, "a mapping with 'tolerance' and exactly one of 'poses' or 'relative'"
         ):
@@ -1196,13 +1194,9 @@ class _Builder:
         return (dx, dy, self.units.angle_in(values[2]) if len(values) == 3 else None)
 
     def reference(self, relative: _Node, objects: dict[str, _Object]) -> str | None:
-        if not relative.has("reference"):
-            self.error(
-                relative.missing("reference"),
-                "missing required key; expected the name of a declared part",
-            )
+        node = self.required(relative, "reference", "the name of a declared part")
+        if node is None:
             return None
-        node = relative.child("reference")
         if not isinstance(node.value, str):
             self.error(node, f"expected the name of a declared part, got {_describe(node.value)}")
             return None

@@ -819,23 +819,17 @@ def draw_heatmap(
             half = HEATMAP_MARK
             along = 0.0 if (xmax - xmin) >= (ymax - ymin) else 0.5 * math.pi
             dx, dy = half * math.cos(theta + along), half * math.sin(theta + along)
-            if edge != "none":
+            # An outlined bar: the edge colour drawn wider underneath the fill colour.
+            strokes = [(edge, 4.2, 3.4)] if edge != "none" else []
+            for stroke, width, z in strokes + [(color, 3.0, 3.45)]:
                 artists += ax.plot(
                     [x - dx, x + dx],
                     [y - dy, y + dy],
-                    color=edge,
-                    linewidth=4.2,
+                    color=stroke,
+                    linewidth=width,
                     solid_capstyle="butt",
-                    zorder=3.4,
+                    zorder=z,
                 )
-            artists += ax.plot(
-                [x - dx, x + dx],
-                [y - dy, y + dy],
-                color=color,
-                linewidth=3.0,
-                solid_capstyle="butt",
-                zorder=3.45,
-            )
     if best is not None and best.fixture is not None and best.pose is not None:
         spec = problem.object(best.fixture)
         artists += draw_object(
