@@ -98,7 +98,11 @@ of simulated time including the rest checks, and the paddle travels 0.0125 in pe
 below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
 above; a 1-inch block of density 0.125 weighs 48, so this pushes a chain of 7 blocks at the
 highest friction and density of the thesis's ranges, 223, with margin, and still stalls against
-a wall instead of crushing through it).
+a wall instead of crushing through it). Densities are in each problem's own units, so a problem
+of heavier parts raises the clip to 1.5 times the friction of all its parts at its nominal
+(mid-range) friction and density (:func:`push_force`): only the noisy TT mating, whose
+densities reach 1.0, is affected (1608); its heaviest draws still stall the push, as the
+thesis's low-gain controller stalled.
 
 Rest
 ====
@@ -219,7 +223,11 @@ class PhysicsSettings:
     """Speed limit of the manipulator (in/s): a careful robot push, 0.0125 in per step."""
     push_force: float = 400.0
     """Force clip of the controller (mass-in/s^2, mass = density x in^2): pushes a 7-block
-    chain at the worst friction and density of the thesis's ranges (223) with margin."""
+    chain at the worst friction and density of the thesis's ranges (223) with margin. A
+    problem whose parts are heavier raises it (see :func:`push_force`)."""
+    load_margin: float = 1.5
+    """The clip is at least this many times the friction of all the problem's parts at the
+    middle of its friction and part-density ranges (:func:`push_force`)."""
     damping_ratio: float = 1.0
     """Damping ratio of the PD; 1 is the thesis's critically damped Kd = sqrt(4 m Kp)."""
     wall_thickness: float = 1.0
@@ -236,6 +244,7 @@ class PhysicsSettings:
             "max_time",
             "push_speed",
             "push_force",
+            "load_margin",
             "damping_ratio",
             "wall_thickness",
             "collision_slop",
@@ -279,6 +288,29 @@ class PhysicsSettings:
 
 
 DEFAULT_SETTINGS = PhysicsSettings()
+
+
+def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS) -> float:
+    """The controller's force clip for ``problem``: ``settings.push_force``, raised to
+    ``load_margin`` times the table friction of every part of the problem at the middle of its
+    friction and part-density ranges when that is more.
+
+    Densities are in the problem's own mass units, so a fixed clip cannot suit every problem:
+    the thesis's noisy TT mating draws densities up to 1.0, eight times the blocks', and a clip
+    sized for blocks could not move its parts at all under nominal parameters. Scaled this way
+    the robot always pushes everything the problem has at once under nominal parameters, with
+    margin, while the heaviest, most frictional draws of a very noisy problem may still stall
+    it, as the thesis's low-gain controller stalled ("doesn't apply enough force to move the
+    desired distance when there are collisions", §2.1.3). Every shipped problem but the noisy
+    TT mating keeps the default (the largest nominal load, TT mating's, needs 398).
+    """
+    u = problem.uncertainty
+    friction = 0.5 * (u.friction[0] + u.friction[1])
+    density = 0.5 * (u.part_density[0] + u.part_density[1])
+    area = sum(spec.shape.area for spec in problem.parts)
+    return max(
+        settings.push_force, settings.load_margin * settings.gravity * friction * density * area
+    )
 
 
 def pd_gains(mass: float, settings: PhysicsSettings = DEFAULT_SETTINGS) -> tuple[float, float]:
@@ -577,10 +609,12 @@ def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
     return _finish(compiled, poses, StepStatus.OK)
 
 
-def _add_drive(space, static, paddle, ref: tuple[float, float], settings: PhysicsSettings):
-    """The clipped PD of the push as a pivot joint (see the module docstring)."""
+def _add_drive(
+    space, static, paddle, ref: tuple[float, float], settings: PhysicsSettings, force: float
+):
+    """The clipped PD of the push as a pivot joint, clipped at ``force`` (module docstring)."""
     joint = lib.cpPivotJointNew2(static, paddle, ref, (0.0, 0.0))
-    lib.cpConstraintSetMaxForce(joint, settings.push_force)
+    lib.cpConstraintSetMaxForce(joint, force)
     lib.cpConstraintSetMaxBias(joint, settings.push_speed)
     lib.cpConstraintSetErrorBias(
         joint, (1.0 - settings.approach_rate * settings.dt) ** (1.0 / settings.dt)
@@ -710,7 +744,14 @@ def _push(
         # steps; the other bodies are watched from the first check the paddle is still, so
         # their rest can count the check at which the drive stops (always followed by at
         # least one check with the brake on).
-        drive = _add_drive(space, static, paddle, (px + distance * dx, py + distance * dy), s)
+        drive = _add_drive(
+            space,
+            static,
+            paddle,
+            (px + distance * dx, py + distance * dy),
+            s,
+            push_force(compiled.problem, s),
+        )
         constraints.append(drive)
         interval = s.interval_steps
         max_steps = s.max_steps
@@ -851,7 +892,9 @@ def _drive_trajectory(
         lib.cpSpaceSetIterations(space, settings.iterations)
         lib.cpBodySetPosition(paddle, start)
         lib.cpSpaceAddBody(space, paddle)
-        drive = _add_drive(space, lib.cpSpaceGetStaticBody(space), paddle, ref, settings)
+        drive = _add_drive(
+            space, lib.cpSpaceGetStaticBody(space), paddle, ref, settings, settings.push_force
+        )
         out = []
         for _ in range(n_steps):
             lib.cpSpaceStep(space, settings.dt)

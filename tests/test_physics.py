@@ -18,6 +18,7 @@ from arrange_up.physics import (
     _abs_r_integral,
     _drive_trajectory,
     pd_gains,
+    push_force,
     rollout,
     simulate,
 )
@@ -99,6 +100,26 @@ def test_block_pushed_against_wall_ends_against_it():
     assert outcome.steps > 0 and outcome.sim_time == pytest.approx(
         outcome.steps * DEFAULT_SETTINGS.dt
     )
+
+
+def test_force_clip_grows_with_heavy_parts_only():
+    """Light problems keep the default clip; a problem of dense parts gets 1.5 times the
+    friction of all its parts at nominal parameters, so the robot moves them under nominal
+    parameters but stalls on the heaviest, most frictional draws."""
+    assert push_force(make_problem(7)) == DEFAULT_SETTINGS.push_force
+    heavy = Uncertainty(friction=(0.4, 0.4), part_density=(2.0, 4.0))
+    problem = make_problem(1, uncertainty=heavy)
+    nominal_load = DEFAULT_SETTINGS.gravity * 0.4 * 3.0 * 1.0  # one 1 x 1 in block
+    assert push_force(problem) == pytest.approx(1.5 * nominal_load)
+    state = state_of(problem, b0=(5.0, 2.5, 0.0))
+    nominal = ActionNoise(friction=0.4, part_density=3.0)
+    moved = simulate(problem, state, push_east(5.0, 2.5, 1.0), nominal)
+    assert moved.ok and moved.state.pose("b0")[0] > 5.8
+    # Twice the nominal density needs more than the clip: the push stalls where it touches.
+    stalled = simulate(
+        problem, state, push_east(5.0, 2.5, 1.0), ActionNoise(friction=0.4, part_density=6.0)
+    )
+    assert stalled.ok and stalled.state.pose("b0")[0] < 5.05
 
 
 def test_push_that_misses_moves_nothing():

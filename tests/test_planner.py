@@ -36,6 +36,20 @@ def test_deterministic_plan_reaches_goal_in_nominal_physics(blocks2):
     assert result.stats["expanded"] >= 1 and result.stats["transitions_simulated"] >= 1
 
 
+def test_dense_parts_still_get_a_nominal_plan():
+    # tt-mating-noisy's parts are up to 8 times denser than blocks; the controller's force clip
+    # follows the problem's masses (physics.push_force), so nominal pushes move them.
+    problem = load("tt-mating-noisy")
+    result = plan(problem, semantics="deterministic")
+    assert result.status == SOLVED and result.actions
+    state = nominal_initial_state(problem)
+    for action in result.actions:
+        outcome = simulate(problem, state, action, nominal_noise(problem))
+        assert outcome.ok
+        state = outcome.state
+    assert GoalTest(problem).satisfied(state)
+
+
 def test_particle_plan_final_belief_satisfies_goal_for_every_particle(blocks2):
     result = plan(blocks2, semantics="particles", particles=8, seed=3)
     assert result.status == SOLVED
