@@ -304,13 +304,15 @@ def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_
     desired distance when there are collisions", §2.1.3). Every shipped problem but the noisy
     TT mating keeps the default (the largest nominal load, TT mating's, needs 398).
     """
+    return _force_clip(problem, sum(spec.shape.area for spec in problem.parts), settings)
+
+
+def _force_clip(problem: ArrangementProblem, parts_area: float, settings: PhysicsSettings) -> float:
     u = problem.uncertainty
     friction = 0.5 * (u.friction[0] + u.friction[1])
     density = 0.5 * (u.part_density[0] + u.part_density[1])
-    area = sum(spec.shape.area for spec in problem.parts)
-    return max(
-        settings.push_force, settings.load_margin * settings.gravity * friction * density * area
-    )
+    load = settings.gravity * friction * density * parts_area
+    return max(settings.push_force, settings.load_margin * load)
 
 
 def pd_gains(mass: float, settings: PhysicsSettings = DEFAULT_SETTINGS) -> tuple[float, float]:
@@ -426,6 +428,7 @@ class _Compiled:
     statics: tuple[tuple[int, object], ...]  # wall and obstacle polygons in world coordinates
     table: Table
     wall_thickness: float
+    parts_area: float  # of all the problem's parts, for the force clip (push_force)
 
 
 _IDENTITY = ffi.new("cpTransform *", (1.0, 0.0, 0.0, 1.0, 0.0, 0.0))[0]
@@ -481,7 +484,8 @@ def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
             abs_r=sum(_abs_r_integral(part) for part in parts),
             push_direction=spec.push_direction,
         )
-    compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness)
+    parts_area = sum(b.area for b in bodies.values() if b.kind is ObjectKind.PART)
+    compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness, parts_area)
     if len(_CACHE) >= _CACHE_SIZE:
         _CACHE.pop(next(iter(_CACHE)))
     _CACHE[key] = compiled
@@ -750,7 +754,7 @@ def _push(
             paddle,
             (px + distance * dx, py + distance * dy),
             s,
-            push_force(compiled.problem, s),
+            _force_clip(compiled.problem, compiled.parts_area, s),
         )
         constraints.append(drive)
         interval = s.interval_steps
