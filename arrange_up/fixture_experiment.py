@@ -277,16 +277,19 @@ def select_rows(
     method: str,
 ) -> list[dict[str, str]]:
     """The rows of one configuration (a CSV may hold several): those problems, plan indices
-    below ``plans``, those particle counts, that seed and method."""
+    below ``plans``, those particle counts, that seed and method; grouped by problem in the
+    order of ``problems`` (a resumed CSV may have them in any order)."""
     counts = {str(n) for n in particles}
-    return [
+    order = {name: k for k, name in enumerate(problems)}
+    selected = [
         r
         for r in rows
-        if r["problem"] in problems
+        if r["problem"] in order
         and int(r["plan"]) < plans
         and r["seed"] == str(seed)
         and (r["stage"] == NOMINAL or (r["particles"] in counts and r["method"] == method))
     ]
+    return sorted(selected, key=lambda r: order[r["problem"]])
 
 
 def _key(*values: Any) -> tuple[str, ...]:

@@ -311,8 +311,10 @@ def _force_clip(problem: ArrangementProblem, parts_area: float, settings: Physic
     u = problem.uncertainty
     friction = 0.5 * (u.friction[0] + u.friction[1])
     density = 0.5 * (u.part_density[0] + u.part_density[1])
-    load = settings.gravity * friction * density * parts_area
-    return max(settings.push_force, settings.load_margin * load)
+    return max(
+        settings.push_force,
+        settings.load_margin * settings.gravity * friction * density * parts_area,
+    )
 
 
 def pd_gains(mass: float, settings: PhysicsSettings = DEFAULT_SETTINGS) -> tuple[float, float]:
@@ -484,7 +486,7 @@ def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
             abs_r=sum(_abs_r_integral(part) for part in parts),
             push_direction=spec.push_direction,
         )
-    parts_area = sum(b.area for b in bodies.values() if b.kind is ObjectKind.PART)
+    parts_area = sum(spec.shape.area for spec in problem.parts)  # as push_force sums it
     compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness, parts_area)
     if len(_CACHE) >= _CACHE_SIZE:
         _CACHE.pop(next(iter(_CACHE)))
