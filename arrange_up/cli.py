@@ -1335,7 +1335,7 @@ def experiment_fixtures(
       arrange-up experiment fixtures --problems tz-mating --plans 2 --particles 10,40 \\
           --rollouts 100 --output-dir tz-quick
       arrange-up experiment fixtures --plans 5 --particles 10,40,150 --workers 1 \\
-          --output-dir docs/results      # docs/results.md: 24 min on 2 cores
+          --output-dir docs/results      # docs/results.md: ~32 min on 2 cores
       arrange-up experiment fixtures --workers 1   # thesis scale: ~2-3 h on 2 cores (est.)
 
     Exit status: 0 the sweep ran (whatever the results), 1 interrupted, 2 bad input or a CSV
