@@ -22,16 +22,21 @@ def blocks2():
     return load("blocks-2")
 
 
+def _replays_to_goal(problem, actions) -> bool:
+    """Replaying ``actions`` with the noise-free physics succeeds and reaches the goal."""
+    state = nominal_initial_state(problem)
+    for action in actions:
+        outcome = simulate(problem, state, action, nominal_noise(problem))
+        if not outcome.ok:
+            return False
+        state = outcome.state
+    return GoalTest(problem).satisfied(state)
+
+
 def test_deterministic_plan_reaches_goal_in_nominal_physics(blocks2):
     result = plan(blocks2, semantics="deterministic")
     assert result.status == SOLVED and result.actions
-    # Replaying the plan with the noise-free physics reaches the goal.
-    state = nominal_initial_state(blocks2)
-    for action in result.actions:
-        outcome = simulate(blocks2, state, action, nominal_noise(blocks2))
-        assert outcome.ok
-        state = outcome.state
-    assert GoalTest(blocks2).satisfied(state)
+    assert _replays_to_goal(blocks2, result.actions)
     assert {type(a) for a in result.actions} == {Place, Push}
     assert result.stats["expanded"] >= 1 and result.stats["transitions_simulated"] >= 1
 
@@ -42,12 +47,7 @@ def test_dense_parts_still_get_a_nominal_plan():
     problem = load("tt-mating-noisy")
     result = plan(problem, semantics="deterministic")
     assert result.status == SOLVED and result.actions
-    state = nominal_initial_state(problem)
-    for action in result.actions:
-        outcome = simulate(problem, state, action, nominal_noise(problem))
-        assert outcome.ok
-        state = outcome.state
-    assert GoalTest(problem).satisfied(state)
+    assert _replays_to_goal(problem, result.actions)
 
 
 def test_particle_plan_final_belief_satisfies_goal_for_every_particle(blocks2):
