@@ -489,12 +489,29 @@ def repair_plan(
     deadline = None if timeout is None else started + timeout
     actions = tuple(actions)
     repairer = _Repairer(problem, particles, seed, method, workers, deadline)
+    records: list[StepRecord] = []
+    out: list[Action] = []
+
+    def result(status: str, plan, reason: str = "", beliefs=()) -> RepairResult:
+        return RepairResult(
+            status,
+            plan,
+            actions,
+            tuple(records),
+            time.monotonic() - started,
+            method,
+            particles,
+            seed,
+            reason=reason,
+            simulations=repairer.simulations,
+            partial=tuple(out),
+            beliefs=tuple(beliefs),
+        )
+
     try:
         states = repairer.nominal_states(actions)
         belief = repairer.initial_belief()
         beliefs = [belief]
-        records: list[StepRecord] = []
-        out: list[Action] = []
         for index, action in enumerate(actions):
             step_started = time.monotonic()
             sims_before = repairer.simulations
@@ -519,20 +536,7 @@ def repair_plan(
             records.append(record)
             if after is None:
                 reason = f"step {index + 1} ({record.kind}): {record.reason}"
-                return RepairResult(
-                    FAILED,
-                    None,
-                    actions,
-                    tuple(records),
-                    time.monotonic() - started,
-                    method,
-                    particles,
-                    seed,
-                    reason=reason,
-                    simulations=repairer.simulations,
-                    partial=tuple(out),
-                    beliefs=tuple(beliefs),
-                )
+                return result(FAILED, None, reason, beliefs)
             out.extend(record.actions)
             belief = after
             beliefs.append(belief)
@@ -548,33 +552,9 @@ def repair_plan(
                         "choice": _describe_choice(record, problem),
                     }
                 )
-        return RepairResult(
-            SOLVED,
-            tuple(out),
-            actions,
-            tuple(records),
-            time.monotonic() - started,
-            method,
-            particles,
-            seed,
-            simulations=repairer.simulations,
-            partial=tuple(out),
-            beliefs=tuple(beliefs),
-        )
+        return result(SOLVED, tuple(out), beliefs=beliefs)
     except _OutOfTime:
-        return RepairResult(
-            TIMEOUT,
-            None,
-            actions,
-            tuple(records),
-            time.monotonic() - started,
-            method,
-            particles,
-            seed,
-            reason=f"timeout of {timeout} s reached",
-            simulations=repairer.simulations,
-            partial=tuple(out),
-        )
+        return result(TIMEOUT, None, f"timeout of {timeout} s reached")
     finally:
         repairer.close()
 
