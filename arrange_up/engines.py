@@ -59,6 +59,7 @@ Parameters: ``rollouts`` (1000), ``seed`` (0), ``workers`` (``None``: all cores)
 
 from __future__ import annotations
 
+import functools
 import sys
 
 # Only ``sys`` at import time: this module is imported when arrange-up is, and must stay cheap
@@ -211,13 +212,8 @@ def _engine_base() -> type:
     return _CACHE["base"]
 
 
+@functools.cache
 def _engine_class() -> type:
-    if "engine" not in _CACHE:
-        _CACHE["engine"] = _build_engine_class()
-    return _CACHE["engine"]
-
-
-def _build_engine_class() -> type:
     import warnings
 
     from unified_planning.engines import Engine
@@ -445,13 +441,8 @@ def _short(value: Any) -> str:
 # ---------------------------------------------------------------------------------------------
 # the reliability validator (imports unified-planning)
 # ---------------------------------------------------------------------------------------------
+@functools.cache
 def _validator_class() -> type:
-    if "validator" not in _CACHE:
-        _CACHE["validator"] = _build_validator_class()
-    return _CACHE["validator"]
-
-
-def _build_validator_class() -> type:
     from unified_planning.engines import Engine
     from unified_planning.engines.mixins import PlanValidatorMixin
 
@@ -608,13 +599,8 @@ REPAIRER_NAME = "arrange-up-fixtures"
 REPAIRER_CLASS = "ArrangeUpFixtureRepairer"
 
 
+@functools.cache
 def _repairer_class() -> type:
-    if "repairer" not in _CACHE:
-        _CACHE["repairer"] = _build_repairer_class()
-    return _CACHE["repairer"]
-
-
-def _build_repairer_class() -> type:
     from unified_planning.engines import Engine
     from unified_planning.engines.mixins import PlanRepairerMixin
 
