@@ -568,25 +568,26 @@ class _Builder:
     def non_negative(
         self, node: _Node, values: tuple[float, ...] | None, what: str
     ) -> tuple[float, ...] | None:
-        if values is None:
-            return None
-        ok = True
-        for item, value in zip(node.items(), values, strict=True):
-            if value < 0:
-                self.error(item, f"negative {what} {_fmt(value)}; expected a value >= 0")
-                ok = False
-        return values if ok else None
+        return self._signed(node, values, what, allow_zero=True)
 
     def positive(
         self, node: _Node, values: tuple[float, ...] | None, what: str
     ) -> tuple[float, ...] | None:
+        return self._signed(node, values, what, allow_zero=False)
+
+    def _signed(
+        self, node: _Node, values: tuple[float, ...] | None, what: str, *, allow_zero: bool
+    ) -> tuple[float, ...] | None:
+        """``values`` (read from list ``node``) if each is >= 0 (> 0 unless ``allow_zero``),
+        else None after reporting every offending item."""
         if values is None:
             return None
         ok = True
         for item, value in zip(node.items(), values, strict=True):
-            if value <= 0:
+            if value < 0 or (value == 0 and not allow_zero):
                 sign = "negative" if value < 0 else "zero"
-                self.error(item, f"{sign} {what} {_fmt(value)}; expected a value > 0")
+                bound = ">= 0" if allow_zero else "> 0"
+                self.error(item, f"{sign} {what} {_fmt(value)}; expected a value {bound}")
                 ok = False
         return values if ok else None
 
