@@ -14,7 +14,13 @@ goal pose composed with the reference part's current belief centre.
 direction (``planning.push_directions`` restricts them), the manipulator is put behind the
 part's belief shadow, turned so that it pushes along the direction, centred on the part's
 belief centre across the direction — shifted along its long side just enough to stay clear of
-walls and of the shadows beside it, as long as it still covers the part's centre.
+walls and of the shadows beside it, as long as it still covers the part's centre. When that
+position *clips* a shadow ahead (its long side overlaps the shadow's side without covering it
+whole, so whether it touches that part is uncertain), the same push is offered a second time
+from the nearest position that misses or wholly covers every shadow ahead. The first position
+keeps plans that move a neighbouring row along (blocks-7 needs it); the second makes contacts
+certain where CBST must refuse a clipped one (without it, a plain row of four blocks against a
+wall had no CBST plan: each new block's push down clipped the block beside it).
 Distances:
 
 * to the wall ahead (the controller stalls when the train of parts is compressed against it),
@@ -242,20 +248,27 @@ class ActionGenerator:
             along = part_box[axis] - APPROACH_GAP - m_box[axis + 2]
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
-        across = self._across(manip, name, interval, axis, along, m_box, on_table)
-        if across is None:
-            return []
-        pose = (along, across, theta) if axis == 0 else (across, along, theta)
-        if not self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
-            return []
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
         distances = self._distances(name, interval, belief, axis, sign, front_nominal)
-        return [Push(manip.spec.name, _clean(pose), round(float(d), 4)) for d in distances]
+        pushes = []
+        for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
+            pose = (along, across, theta) if axis == 0 else (across, along, theta)
+            if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
+                pushes.extend(
+                    Push(manip.spec.name, _clean(pose), round(float(d), 4)) for d in distances
+                )
+        return pushes
 
-    def _across(self, manip, name, interval, axis, along, m_box, on_table) -> float | None:
-        """Where to centre the manipulator across the push: as near the part's centre as the
-        walls and the shadows beside the approach allow, while its long side still covers the
-        part's centre (with 0.1 in to spare). None if no such place exists."""
+    def _across(self, manip, name, interval, axis, sign, along, m_box, on_table) -> list[float]:
+        """Where to centre the manipulator across the push (at most two centres).
+
+        The first is as near the part's centre as the walls and the shadows beside the approach
+        allow, while the manipulator's long side still covers the part's centre (with 0.1 in to
+        spare). When it clips the side of a shadow *ahead* of the approach (the manipulator's
+        span overlaps that shadow's span without covering it whole, so the contact may or may
+        not happen), the second is the nearest centre at which every shadow ahead is either
+        missed or covered whole. Empty if no centre fits.
+        """
         other = 1 - axis
         centre = interval.center[other]
         reach = 0.5 * manip.length - 0.1
@@ -263,37 +276,55 @@ class ActionGenerator:
         low = max(centre - reach, low_lim - m_box[other])
         high = min(centre + reach, high_lim - m_box[other + 2])
         if low > high:
-            return None
-        # Shadows level with the approach forbid the centres that would make them overlap.
+            return []
         a_lo, a_hi = along + m_box[axis], along + m_box[axis + 2]
-        forbidden = []
-        for other_name, pose, half in on_table:
-            if other_name == name:
-                continue
-            box = self.checker.shadow_box(other_name, pose, half)
-            if box[axis + 2] > a_lo - APPROACH_GAP and box[axis] < a_hi + APPROACH_GAP:
-                forbidden.append(
-                    (
-                        box[other] - m_box[other + 2] - APPROACH_GAP,
-                        box[other + 2] - m_box[other] + APPROACH_GAP,
-                    )
-                )
-        for box in self.checker.obstacle_boxes.values():
-            if box[axis + 2] > a_lo - APPROACH_GAP and box[axis] < a_hi + APPROACH_GAP:
-                forbidden.append(
-                    (
-                        box[other] - m_box[other + 2] - APPROACH_GAP,
-                        box[other + 2] - m_box[other] + APPROACH_GAP,
-                    )
-                )
-        # Candidate centres: the preferred one and the edges of every forbidden interval.
+        boxes = [
+            self.checker.shadow_box(other_name, pose, half)
+            for other_name, pose, half in on_table
+            if other_name != name
+        ]
+        # Shadows (and obstacles) level with the approach forbid the centres that would make
+        # them overlap: each gives the open interval of such centres.
+        forbidden = [
+            (
+                box[other] - m_box[other + 2] - APPROACH_GAP,
+                box[other + 2] - m_box[other] + APPROACH_GAP,
+            )
+            for box in boxes + list(self.checker.obstacle_boxes.values())
+            if box[axis + 2] > a_lo - APPROACH_GAP and box[axis] < a_hi + APPROACH_GAP
+        ]
+        # Shadows ahead: the centres at which the approach shadow touches one (the interval
+        # it is forbidden from when level) and those at which the nominal manipulator covers
+        # it whole. Touching without covering is clipping.
+        half_length = 0.5 * manip.length
+        ahead = [
+            (
+                box[other] - m_box[other + 2] - APPROACH_GAP,
+                box[other + 2] - m_box[other] + APPROACH_GAP,
+                box[other + 2] - half_length,
+                box[other] + half_length,
+            )
+            for box in boxes
+            if (
+                box[axis] >= a_hi - APPROACH_GAP
+                if sign > 0
+                else box[axis + 2] <= a_lo + APPROACH_GAP
+            )
+        ]
+        # Candidate centres: the preferred one and the edges of every interval above.
         candidates = [min(max(centre, low), high)]
-        candidates += [v for lo, hi in forbidden for v in (lo, hi) if low <= v <= high]
+        candidates += [v for bounds in forbidden + ahead for v in bounds if low <= v <= high]
         candidates.sort(key=lambda v: abs(v - centre))
-        for value in candidates:
-            if all(not (lo < value < hi) for lo, hi in forbidden):
-                return value
-        return None
+        allowed = [v for v in candidates if all(not (lo < v < hi) for lo, hi in forbidden)]
+        if not allowed:
+            return []
+        for value in allowed:
+            if all(
+                not (touch_lo < value < touch_hi) or cover_lo <= value <= cover_hi
+                for touch_lo, touch_hi, cover_lo, cover_hi in ahead
+            ):
+                return [allowed[0]] if abs(value - allowed[0]) <= 1e-6 else [allowed[0], value]
+        return [allowed[0]]
 
     def _across_limits(self, other: int) -> tuple[float, float]:
         """The coordinate range across a push that keeps clear of walls on that axis."""

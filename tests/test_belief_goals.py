@@ -201,3 +201,39 @@ def test_place_candidates_for_relative_goal_follow_reference():
     target = generator.place_target("U", t)
     assert target == pytest.approx((4.0, 6.0, math.pi / 2))
     assert all(isinstance(a, Place) and a.obj == "U" for a in generator.places(t))
+
+
+def test_push_that_clips_a_neighbour_is_also_offered_clear_of_it():
+    # A row of three blocks ends at C; D has just been placed beside it. Pushing D down from a
+    # paddle centred on D clips the side of C's shadow (the paddle may or may not touch C), so
+    # the same push is offered a second time from where the paddle misses C or covers it whole.
+    p = problem(BLOCKS_2)
+    checker = CollisionChecker(p)
+    generator = ActionGenerator(p, checker)
+    c_iv = ObjectInterval((7.513, 0.564, 0.0), (0.027, 0.064, math.radians(3.2)))
+    d_iv = ObjectInterval((6.088, 0.912, 0.0), p.uncertainty.place)
+    belief = IntervalBelief((("A", c_iv), ("B", d_iv)))
+    half = 0.5 * 2.5  # the paddle's half length
+
+    def centres_pushing_d_down(belief):
+        # Pushes down (theta -pi) whose paddle covers D's centre with 0.1 in to spare.
+        return sorted(
+            {
+                a.pose[0]
+                for a in generator.pushes(belief)
+                if round(a.pose[2], 3) == round(-math.pi, 3) and abs(a.pose[0] - 6.088) < half
+            }
+        )
+
+    centres = centres_pushing_d_down(belief)
+    assert len(centres) == 2
+    assert 6.088 in centres  # the first stays centred on the pushed block
+    c_low, _, c_high, _ = checker.shadow_box("A", c_iv.center, c_iv.half)
+    assert c_low < 6.088 + half < c_high  # ... and clips C
+    (clear,) = [x for x in centres if x != 6.088]
+    missed = clear + half <= c_low
+    covered = clear - half <= c_low and clear + half >= c_high
+    assert missed or covered
+    assert abs(clear - 6.088) <= half - 0.1
+    # Nothing ahead to clip: one position only, as before.
+    assert centres_pushing_d_down(IntervalBelief((("B", d_iv),))) == [6.088]

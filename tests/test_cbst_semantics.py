@@ -10,8 +10,9 @@ import pytest
 
 from arrange_up.belief import IntervalBelief
 from arrange_up.cbst.features import BUCKLE_LIMIT
-from arrange_up.domains import load
+from arrange_up.domains import load, resolve_problem
 from arrange_up.goals import GoalTest
+from arrange_up.loader import load_problem_text
 from arrange_up.physics import rollout
 from arrange_up.planner import plan
 from arrange_up.problem import InitialObject
@@ -198,5 +199,27 @@ def test_plans_end_to_end(name):
     assert result.stats["transitions_simulated"] > 0
     # The plan is conformant in simulation too (a few noisy rollouts).
     for seed in range(5):
+        state = _simulate_plan(problem, result.actions, seed)
+        assert state is not None and goal.satisfied(state)
+
+
+def test_plans_a_row_of_four_against_a_wall():
+    # Each new block's push down clips the block beside it unless the paddle is moved clear;
+    # before the action generator offered that position, this row had no CBST plan at all.
+    text = resolve_problem("blocks-4").read_text()
+    text = text.replace("C: [9.5, 1.5, 0]", "C: [7.5, 0.5, 0]").replace(
+        "D: [8.5, 1.5, 0]", "D: [6.5, 0.5, 0]"
+    )
+    problem = load_problem_text(text, "row-of-four.yaml")
+    assert [problem.goal.target(n)[:2] for n in "ABCD"] == [
+        (9.5, 0.5),
+        (8.5, 0.5),
+        (7.5, 0.5),
+        (6.5, 0.5),
+    ]
+    result = plan(problem, semantics="cbst", timeout=60)
+    assert result.solved, result.stats
+    goal = GoalTest(problem)
+    for seed in range(3):
         state = _simulate_plan(problem, result.actions, seed)
         assert state is not None and goal.satisfied(state)
