@@ -24,7 +24,15 @@ from arrange_up.domains import (
 from arrange_up.loader import load_problem
 from arrange_up.problem import WALL_EDGES, ArrangementProblem
 
-BLOCKS = {"blocks-1": 1, "blocks-2": 2, "blocks-3": 3, "blocks-4": 4, "blocks-7": 7, "blocks-9": 9}
+BLOCKS = {
+    "blocks-1": 1,
+    "blocks-2": 2,
+    "blocks-3": 3,
+    "blocks-4": 4,
+    "blocks-7": 7,
+    "blocks-9": 9,
+    "blocks-9-square": 9,
+}
 REARRANGEMENT = ("down-push", "create-a-t", "tz-mating", "tt-mating", "tt-mating-noisy")
 EXPECTED = (*BLOCKS, *REARRANGEMENT)
 RELATIVE = ("create-a-t", "tz-mating", "tt-mating", "tt-mating-noisy")
@@ -157,8 +165,11 @@ def test_blocks_4_is_the_format_example(problems: dict[str, ArrangementProblem])
 def test_block_shapes_of_the_larger_goals(problems: dict[str, ArrangementProblem]) -> None:
     rows7 = sorted(round(pose[1], 9) for _, pose in problems["blocks-7"].goal.targets)
     assert rows7.count(0.5) == 4 and rows7.count(1.5) == 3  # a staircase
-    xs9 = {round(pose[0], 9) for _, pose in problems["blocks-9"].goal.targets}
-    ys9 = {round(pose[1], 9) for _, pose in problems["blocks-9"].goal.targets}
+    rows9 = sorted(round(pose[1], 9) for _, pose in problems["blocks-9"].goal.targets)
+    assert rows9.count(0.5) == 6 and rows9.count(1.5) == 3  # a longer staircase
+    assert problems["blocks-9"].planning.max_nodes == 10000
+    xs9 = {round(pose[0], 9) for _, pose in problems["blocks-9-square"].goal.targets}
+    ys9 = {round(pose[1], 9) for _, pose in problems["blocks-9-square"].goal.targets}
     assert xs9 == {7.5, 8.5, 9.5} and ys9 == {0.5, 1.5, 2.5}  # a 3x3 square
 
 
