@@ -14,13 +14,18 @@ goal pose composed with the reference part's current belief centre.
 direction (``planning.push_directions`` restricts them), the manipulator is put behind the
 part's belief shadow, turned so that it pushes along the direction, centred on the part's
 belief centre across the direction — shifted along its long side just enough to stay clear of
-walls and of the shadows beside it, as long as it still covers the part's centre. When that
-position *clips* a shadow ahead (its long side overlaps the shadow's side without covering it
-whole, so whether it touches that part is uncertain), the same push is offered a second time
-from the nearest position that misses or wholly covers every shadow ahead. The first position
-keeps plans that move a neighbouring row along (blocks-7 needs it); the second makes contacts
-certain where CBST must refuse a clipped one (without it, a plain row of four blocks against a
-wall had no CBST plan: each new block's push down clipped the block beside it).
+walls and of the shadows beside it, as long as it still covers the part's centre.
+
+With ``unclipped_pushes`` (the planner sets it for semantics that refuse uncertain contacts,
+i.e. CBST), when that position *clips* a shadow ahead (its long side overlaps the shadow's side
+without covering it whole, so whether it touches that part is uncertain), the same push is
+offered a second time from the nearest position that misses or wholly covers every shadow
+ahead. The first position keeps plans that move a neighbouring row along (CBST's blocks-7 plan
+needs it); the second makes contacts certain where CBST must refuse a clipped one (without it, a
+plain row of four blocks against a wall had no CBST plan: each new block's push down clipped
+the block beside it). Particle semantics simulate clipped contacts, and for them the extra
+pushes only widen the search (50-particle blocks-7 then ran out of nodes in 2 of 3 seeds), so
+it is off by default.
 Distances:
 
 * to the wall ahead (the controller stalls when the train of parts is compressed against it),
@@ -78,9 +83,16 @@ class _Manipulator:
 class ActionGenerator:
     """Proposes the candidate actions of a belief (see the module docstring)."""
 
-    def __init__(self, problem: ArrangementProblem, checker: CollisionChecker) -> None:
+    def __init__(
+        self,
+        problem: ArrangementProblem,
+        checker: CollisionChecker,
+        *,
+        unclipped_pushes: bool = False,
+    ) -> None:
         self.problem = problem
         self.checker = checker
+        self.unclipped_pushes = unclipped_pushes
         hints = problem.planning
         self.directions = tuple(hints.push_directions or DIRECTIONS)
         self.push_distances = tuple(hints.push_distances or ())
@@ -264,10 +276,10 @@ class ActionGenerator:
 
         The first is as near the part's centre as the walls and the shadows beside the approach
         allow, while the manipulator's long side still covers the part's centre (with 0.1 in to
-        spare). When it clips the side of a shadow *ahead* of the approach (the manipulator's
-        span overlaps that shadow's span without covering it whole, so the contact may or may
-        not happen), the second is the nearest centre at which every shadow ahead is either
-        missed or covered whole. Empty if no centre fits.
+        spare). With ``unclipped_pushes``, when it clips the side of a shadow *ahead* of the
+        approach (the manipulator's span overlaps that shadow's span without covering it whole,
+        so the contact may or may not happen), the second is the nearest centre at which every
+        shadow ahead is either missed or covered whole. Empty if no centre fits.
         """
         other = 1 - axis
         centre = interval.center[other]
@@ -293,9 +305,9 @@ class ActionGenerator:
             for box in boxes + list(self.checker.obstacle_boxes.values())
             if box[axis + 2] > a_lo - APPROACH_GAP and box[axis] < a_hi + APPROACH_GAP
         ]
-        # Shadows ahead: the centres at which the approach shadow touches one (the interval
-        # it is forbidden from when level) and those at which the nominal manipulator covers
-        # it whole. Touching without covering is clipping.
+        # Shadows ahead (only with unclipped_pushes): the centres at which the approach shadow
+        # touches one (the interval it is forbidden from when level) and those at which the
+        # nominal manipulator covers it whole. Touching without covering is clipping.
         half_length = 0.5 * manip.length
         ahead = [
             (
@@ -304,7 +316,7 @@ class ActionGenerator:
                 box[other + 2] - half_length,
                 box[other] + half_length,
             )
-            for box in boxes
+            for box in (boxes if self.unclipped_pushes else [])
             if (
                 box[axis] >= a_hi - APPROACH_GAP
                 if sign > 0

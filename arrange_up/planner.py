@@ -141,7 +141,9 @@ def plan(
     model = make_semantics(semantics, problem, particles=particles, seed=seed, workers=workers)
     checker = CollisionChecker(problem)
     goal = GoalTest(problem)
-    generator = ActionGenerator(problem, checker)
+    generator = ActionGenerator(
+        problem, checker, unclipped_pushes=getattr(model, "refuses_uncertain_contacts", False)
+    )
     h = make_heuristic(heuristic, problem, goal, checker, generator)
 
     def successors(belief: ParticleBelief):

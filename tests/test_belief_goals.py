@@ -206,16 +206,17 @@ def test_place_candidates_for_relative_goal_follow_reference():
 def test_push_that_clips_a_neighbour_is_also_offered_clear_of_it():
     # A row of three blocks ends at C; D has just been placed beside it. Pushing D down from a
     # paddle centred on D clips the side of C's shadow (the paddle may or may not touch C), so
-    # the same push is offered a second time from where the paddle misses C or covers it whole.
+    # with unclipped_pushes the same push is offered a second time from where the paddle misses
+    # C or covers it whole.
     p = problem(BLOCKS_2)
     checker = CollisionChecker(p)
-    generator = ActionGenerator(p, checker)
+    generator = ActionGenerator(p, checker, unclipped_pushes=True)
     c_iv = ObjectInterval((7.513, 0.564, 0.0), (0.027, 0.064, math.radians(3.2)))
     d_iv = ObjectInterval((6.088, 0.912, 0.0), p.uncertainty.place)
     belief = IntervalBelief((("A", c_iv), ("B", d_iv)))
     half = 0.5 * 2.5  # the paddle's half length
 
-    def centres_pushing_d_down(belief):
+    def centres_pushing_d_down(belief, generator=generator):
         # Pushes down (theta -pi) whose paddle covers D's centre with 0.1 in to spare.
         return sorted(
             {
@@ -235,5 +236,7 @@ def test_push_that_clips_a_neighbour_is_also_offered_clear_of_it():
     covered = clear - half <= c_low and clear + half >= c_high
     assert missed or covered
     assert abs(clear - 6.088) <= half - 0.1
-    # Nothing ahead to clip: one position only, as before.
+    # Nothing ahead to clip: one position only.
     assert centres_pushing_d_down(IntervalBelief((("B", d_iv),))) == [6.088]
+    # Off by default (particle semantics simulate clipped contacts): one position only.
+    assert centres_pushing_d_down(belief, ActionGenerator(p, checker)) == [6.088]

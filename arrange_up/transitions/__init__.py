@@ -22,7 +22,13 @@ from arrange_up.world import Action
 
 
 class Semantics(Protocol):
-    """What the planner needs from a transition semantics."""
+    """What the planner needs from a transition semantics.
+
+    A semantics may also set ``refuses_uncertain_contacts = True`` (read with ``getattr``,
+    default False) when it cannot predict a push whose manipulator may or may not touch a part
+    (CBST does so): the planner then also proposes pushes from manipulator positions that miss
+    or wholly cover every part ahead (see :mod:`arrange_up.actions`).
+    """
 
     name: str
     particles: int

@@ -72,6 +72,9 @@ class CBSTSemantics:
     """
 
     name = "cbst"
+    #: The contact graph refuses a push whose paddle may or may not touch a block, so the
+    #: planner also proposes paddle positions that avoid such contacts.
+    refuses_uncertain_contacts = True
 
     def __init__(
         self,
