@@ -24,7 +24,7 @@ ahead. The first position keeps plans that move a neighbouring row along (CBST's
 needs it); the second makes contacts certain where CBST must refuse a clipped one (without it, a
 plain row of four blocks against a wall had no CBST plan: each new block's push down clipped
 the block beside it). Particle semantics simulate clipped contacts, and for them the extra
-pushes only widen the search (50-particle blocks-7 then ran out of nodes in 2 of 3 seeds), so
+pushes only widen the search (25-particle blocks-7 then ran out of nodes in 2 of 3 seeds), so
 it is off by default.
 Distances:
 

@@ -206,7 +206,7 @@ def test_plans_end_to_end(name):
 def test_plans_a_row_of_four_against_a_wall():
     # Each new block's push down clips the block beside it unless the paddle is moved clear;
     # before the action generator offered that position, this row had no CBST plan at all.
-    text = resolve_problem("blocks-4").read_text()
+    text = resolve_problem("blocks-4").read_text(encoding="utf-8")
     text = text.replace("C: [9.5, 1.5, 0]", "C: [7.5, 0.5, 0]").replace(
         "D: [8.5, 1.5, 0]", "D: [6.5, 0.5, 0]"
     )
