@@ -441,6 +441,23 @@ def _short(value: Any) -> str:
 # ---------------------------------------------------------------------------------------------
 # the reliability validator (imports unified-planning)
 # ---------------------------------------------------------------------------------------------
+def _read_problem_and_plan(problem: Any, plan: Any) -> tuple[Any, Any] | str:
+    """The arrange-up problem and action list of a unified-planning ``problem`` and ``plan``,
+    or the message that says which of the two is not one (the validator and the repairer
+    answer with it; engines never raise)."""
+    from arrange_up.compile import from_up, plan_from_up
+
+    try:
+        arrangement = from_up(problem)
+    except ValueError as error:  # ProblemFormatError is a ValueError
+        return f"not an arrange-up problem: {error}"
+    try:
+        actions = plan_from_up(plan)
+    except (AttributeError, TypeError, ValueError) as error:
+        return f"not a sequential plan of place/push/pick actions: {error}"
+    return arrangement, actions
+
+
 @functools.cache
 def _validator_class() -> type:
     from unified_planning.engines import Engine
@@ -498,7 +515,6 @@ def _validate(engine: Any, problem: Any, plan: Any) -> Any:
     from unified_planning.engines import LogLevel, LogMessage, ValidationResult
     from unified_planning.engines.results import FailedValidationReason, ValidationResultStatus
 
-    from arrange_up.compile import from_up, plan_from_up
     from arrange_up.evaluate import GOAL_MISSED, evaluate_plan
 
     def unknown(message: str) -> Any:
@@ -508,14 +524,10 @@ def _validate(engine: Any, problem: Any, plan: Any) -> Any:
             log_messages=[LogMessage(LogLevel.ERROR, message)],
         )
 
-    try:
-        arrangement = from_up(problem)
-    except ValueError as error:  # ProblemFormatError is a ValueError
-        return unknown(f"not an arrange-up problem: {error}")
-    try:
-        actions = plan_from_up(plan)
-    except (AttributeError, TypeError, ValueError) as error:
-        return unknown(f"not a sequential plan of place/push/pick actions: {error}")
+    read = _read_problem_and_plan(problem, plan)
+    if isinstance(read, str):
+        return unknown(read)
+    arrangement, actions = read
     try:
         outcome = evaluate_plan(
             arrangement,
@@ -665,7 +677,7 @@ def _repair(engine: Any, problem: Any, plan: Any) -> Any:
     from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
     from unified_planning.engines import PlanGenerationResultStatus as Status
 
-    from arrange_up.compile import from_up, made_by_to_up, plan_from_up, plan_to_up, to_up
+    from arrange_up.compile import made_by_to_up, plan_to_up, to_up
     from arrange_up.repair import repair_plan
 
     def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
@@ -676,14 +688,10 @@ def _repair(engine: Any, problem: Any, plan: Any) -> Any:
     def refuse(message: str) -> Any:
         return result(Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, message)])
 
-    try:
-        arrangement = from_up(problem)
-    except ValueError as error:  # ProblemFormatError is a ValueError
-        return refuse(f"not an arrange-up problem: {error}")
-    try:
-        nominal = plan_from_up(plan)
-    except (AttributeError, TypeError, ValueError) as error:
-        return refuse(f"not a sequential plan of place/push/pick actions: {error}")
+    read = _read_problem_and_plan(problem, plan)
+    if isinstance(read, str):
+        return refuse(read)
+    arrangement, nominal = read
     try:
         outcome = repair_plan(
             arrangement,
