@@ -318,7 +318,7 @@ def _solve(engine: Any, problem: Any, heuristic: Any, timeout: float | None, str
     from unified_planning.engines import PlanGenerationResultStatus as Status
 
     from arrange_up import planner
-    from arrange_up.compile import from_up, made_by_to_up, plan_to_up, to_up
+    from arrange_up.compile import from_up
 
     started = time.monotonic()
     if heuristic is not None:
@@ -381,18 +381,7 @@ def _solve(engine: Any, problem: Any, heuristic: Any, timeout: float | None, str
     )
     limit = outcome.stats.get("max_nodes")
     if outcome.status == planner.SOLVED and outcome.actions is not None:
-        logs = []
-        target = problem
-        if not made_by_to_up(problem):
-            target = to_up(arrangement, environment=problem.environment)
-            logs.append(
-                LogMessage(
-                    LogLevel.INFO,
-                    "the problem came from PDDL, whose actions have no real parameters: the "
-                    "plan's actions are those of arrange_up.compile.to_up(from_up(problem))",
-                )
-            )
-        plan = plan_to_up(target, [_plain(a) for a in outcome.actions])
+        plan, logs = _plan_to_up(problem, arrangement, outcome.actions)
         return result(Status.SOLVED_SATISFICING, plan, logs, metrics)
     if outcome.status == planner.TIMEOUT or (outcome.status == planner.CANCELLED and out_of_time()):
         message = f"timeout of {timeout} s reached without a plan"
@@ -416,6 +405,28 @@ def _solve(engine: Any, problem: Any, heuristic: Any, timeout: float | None, str
         )
     message = f"the planner stopped with status {outcome.status!r}"
     return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)
+
+
+def _plan_to_up(problem: Any, arrangement: Any, actions: Any) -> tuple[Any, list[Any]]:
+    """The unified-planning plan of ``actions`` for ``problem``, and the log messages to return
+    with it. A problem that did not come from :func:`arrange_up.compile.to_up` (one read from
+    PDDL) has no actions with real parameters, so the plan is one of ``to_up(arrangement)``."""
+    from unified_planning.engines import LogLevel, LogMessage
+
+    from arrange_up.compile import made_by_to_up, plan_to_up, to_up
+
+    logs = []
+    target = problem
+    if not made_by_to_up(problem):
+        target = to_up(arrangement, environment=problem.environment)
+        logs.append(
+            LogMessage(
+                LogLevel.INFO,
+                "the problem came from PDDL, whose actions have no real parameters: the "
+                "plan's actions are those of arrange_up.compile.to_up(from_up(problem))",
+            )
+        )
+    return plan_to_up(target, [_plain(a) for a in actions]), logs
 
 
 def _plain(action: Any) -> Any:
@@ -677,7 +688,6 @@ def _repair(engine: Any, problem: Any, plan: Any) -> Any:
     from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
     from unified_planning.engines import PlanGenerationResultStatus as Status
 
-    from arrange_up.compile import made_by_to_up, plan_to_up, to_up
     from arrange_up.repair import repair_plan
 
     def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
@@ -735,16 +745,5 @@ def _repair(engine: Any, problem: Any, plan: Any) -> Any:
             [LogMessage(LogLevel.INFO, f"the repair {outcome.status}: {outcome.reason}")],
             metrics,
         )
-    logs = []
-    target = problem
-    if not made_by_to_up(problem):
-        target = to_up(arrangement, environment=problem.environment)
-        logs.append(
-            LogMessage(
-                LogLevel.INFO,
-                "the problem came from PDDL, whose actions have no real parameters: the "
-                "plan's actions are those of arrange_up.compile.to_up(from_up(problem))",
-            )
-        )
-    repaired = plan_to_up(target, [_plain(a) for a in outcome.actions])
+    repaired, logs = _plan_to_up(problem, arrangement, outcome.actions)
     return result(Status.SOLVED_SATISFICING, repaired, logs, metrics)
