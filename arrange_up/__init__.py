@@ -18,20 +18,20 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from arrange_up.engines import register as _register_up_engines
+from arrange_up.up.engines import register as _register_up_engines
 
 __version__ = "0.1.0"
 __all__ = ["load", "plan", "to_up", "__version__"]
 
 if TYPE_CHECKING:  # pragma: no cover
-    from arrange_up.compile import to_up
-    from arrange_up.domains import load
-    from arrange_up.planner import plan
+    from arrange_up.io.domains import load
+    from arrange_up.planning.planner import plan
+    from arrange_up.up.compile import to_up
 
 _LAZY = {
-    "load": ("arrange_up.domains", "load"),
-    "plan": ("arrange_up.planner", "plan"),
-    "to_up": ("arrange_up.compile", "to_up"),
+    "load": ("arrange_up.io.domains", "load"),
+    "plan": ("arrange_up.planning.planner", "plan"),
+    "to_up": ("arrange_up.up.compile", "to_up"),
 }
 
 

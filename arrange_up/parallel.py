@@ -1,6 +1,6 @@
 """Running independent simulation batches in parallel: local processes or a Dask cluster.
 
-Rollouts of a plan (:mod:`arrange_up.evaluate`), and later other embarrassingly parallel
+Rollouts of a plan (:mod:`arrange_up.evaluation.evaluate`), and later other embarrassingly parallel
 batches (training data for learned transition models, benchmarks), go through one small
 abstraction, a :class:`Runner`::
 

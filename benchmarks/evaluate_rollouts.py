@@ -30,9 +30,9 @@ from pathlib import Path
 
 
 def _plan(problem_name: str, max_nodes: int | None) -> Path:
-    from arrange_up.domains import load
-    from arrange_up.planfile import plan_document, write_json_atomic
-    from arrange_up.planner import plan
+    from arrange_up.io.domains import load
+    from arrange_up.io.planfile import plan_document, write_json_atomic
+    from arrange_up.planning.planner import plan
 
     problem = load(problem_name)
     t0 = time.perf_counter()
@@ -67,11 +67,11 @@ def main() -> int:
     parser.add_argument("--no-dask", action="store_true")
     args = parser.parse_args()
 
-    from arrange_up.domains import load
-    from arrange_up.evaluate import _Context, _rollout_task, evaluate_plan, plan_hash
+    from arrange_up.evaluation.evaluate import _Context, _rollout_task, evaluate_plan, plan_hash
+    from arrange_up.io.domains import load
+    from arrange_up.io.planfile import read_plan
+    from arrange_up.model.problem import problem_hash
     from arrange_up.parallel import _apply_chunk, _chunks, auto_chunksize, get_runner
-    from arrange_up.planfile import read_plan
-    from arrange_up.problem import problem_hash
 
     problem = load(args.problem)
     plan_path = Path(args.plan) if args.plan else _plan(args.problem, args.max_nodes)

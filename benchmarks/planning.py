@@ -17,8 +17,8 @@ import csv
 import time
 from pathlib import Path
 
-from arrange_up.domains import load
-from arrange_up.planner import plan
+from arrange_up.io.domains import load
+from arrange_up.planning.planner import plan
 
 FIELDS = [
     "problem",

@@ -1,5 +1,5 @@
 ; blocks-1: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: One block pushed into the lower-right corner of the board. The smallest
 ;   construction problem (thesis ch. 3, Table 3.1 '1 Block'): place the block, then push it
 ;   against the right and bottom walls, which make its final pose certain. Block world of thesis

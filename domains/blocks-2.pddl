@@ -1,5 +1,5 @@
 ; blocks-2: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Two blocks in a row along the bottom wall, in the lower-right corner. A 2-block
 ;   construction problem (thesis ch. 3, Table 3.1 '2 Blocks'; one of the five real-robot
 ;   assemblies of §3.3). Block world of thesis ch. 3 on the real-robot set-up of §2.4.2: a 10 x

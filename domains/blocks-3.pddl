@@ -1,5 +1,5 @@
 ; blocks-3: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Three blocks as an L in the lower-right corner. Two blocks lie along the bottom
 ;   wall and the third sits on the corner block against the right wall. A 3-block construction
 ;   problem (thesis ch. 3, Table 3.1 '3 Blocks'; one of the five real-robot assemblies of §3.3).

@@ -1,5 +1,5 @@
 ; blocks-4: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Four blocks as a 2x2 square in the lower-right corner. The 4-block construction
 ;   problem (thesis ch. 3, Table 3.1 '4 Blocks', Figures 3-6 and 3-7; one of the five real-robot
 ;   assemblies of §3.3); also the example of the problem format. Block world of thesis ch. 3 on

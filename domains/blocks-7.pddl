@@ -1,5 +1,5 @@
 ; blocks-7: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Seven blocks as a staircase in the lower-right corner. Four blocks lie along
 ;   the bottom wall (A-D from the corner) and three on top of them against the right wall (E-G).
 ;   The 7-block construction problem (thesis ch. 3, Table 3.1 '7 Blocks', Figures 3-6 and 3-7,

@@ -1,5 +1,5 @@
 ; blocks-9-square: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Nine blocks as a 3x3 square in the lower-right corner. Rows from the bottom
 ;   wall up, each from the right wall leftwards (A-C, D-F, G-I). A harder 9-block assembly than
 ;   blocks-9, kept as an open problem: CBST finds no plan for it (four blocks sit in "pockets",

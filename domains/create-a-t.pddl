@@ -1,5 +1,5 @@
 ; create-a-t: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Two rectangular bars pushed together into a T. The Create a T rearrangement
 ;   problem of thesis ch. 4 (Figures 2-15(c,d) and 4-12(c,d); Table 4.2's "Create a T" row), by
 ;   far the hardest of the chapter's problems: both bars start on the table (+-0.35 in, +-5

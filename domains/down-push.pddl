@@ -1,5 +1,5 @@
 ; down-push: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: One block in the middle of the table pushed straight down 3 inches. The Down
 ;   Push rearrangement problem of thesis ch. 4 (Figures 2-15(a,b), 4-12(a,b) and 4-15; Table
 ;   4.2's "Down Push" row): the part starts on the table with a large initial uncertainty (+-1.0

@@ -1,5 +1,5 @@
 ; tt-mating: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: Two T-shaped parts pushed together until they interlock. The TT mating
 ;   rearrangement problem of thesis ch. 4 (Figures 2-16(c,d), 4-13(c,d) and 4-18; Table 4.2's
 ;   "TT mating" row): two identical non-convex T's start on the table (+-0.5 in, +-5 deg), the

@@ -1,5 +1,5 @@
 ; tz-mating: an arrange-up problem in PDDL 2.1 for the domain arrange-up (arrange-up-domain.pddl).
-; Units: inches and degrees. Written by arrange_up.pddl.write_pddl_problem.
+; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.
 ; description: A T-shaped and a Z-shaped part pushed together until they interlock. The TZ
 ;   mating rearrangement problem of thesis ch. 4 (Figures 2-16(a,b), 4-2 to 4-11 and 4-13(a,b);
 ;   Table 4.2's "TZ mating" row): two non-convex parts start on the table with small uncertainty

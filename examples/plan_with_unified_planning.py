@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import sys
 
-from arrange_up.compile import to_up
-from arrange_up.domains import load
-from arrange_up.engines import register
+from arrange_up.io.domains import load
+from arrange_up.up.compile import to_up
+from arrange_up.up.engines import register
 
 
 def main(name: str = "blocks-2") -> int:

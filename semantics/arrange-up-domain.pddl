@@ -4,11 +4,11 @@
 ; real-valued parameters or effects computed by a physics simulation, so this file declares what
 ; PDDL can: the types, the functions and predicates that describe a problem, and the three
 ; actions with their symbolic preconditions. What a place or push does to the poses is defined
-; by arrange-up's transition semantics (arrange_up.compile.to_up builds the unified-planning
+; by arrange-up's transition semantics (arrange_up.up.compile.to_up builds the unified-planning
 ; model with real parameters and simulated effects).
 ;
 ; Units: lengths in inches, angles in degrees. Generated from semantics/shapes.yaml by
-; arrange_up.pddl.domain_pddl_text(); a test keeps this file and the catalogue in step.
+; arrange_up.io.pddl.domain_pddl_text(); a test keeps this file and the catalogue in step.
 (define (domain arrange-up)
   (:requirements :strips :typing :negative-preconditions :numeric-fluents)
 

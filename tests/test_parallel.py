@@ -94,9 +94,9 @@ def test_missing_dask_gives_an_install_hint(monkeypatch):
 
 def test_dask_local_cluster_matches_local_processes():
     pytest.importorskip("distributed")
-    from arrange_up.domains import load
-    from arrange_up.evaluate import evaluate_plan
-    from arrange_up.planner import plan
+    from arrange_up.evaluation.evaluate import evaluate_plan
+    from arrange_up.io.domains import load
+    from arrange_up.planning.planner import plan
 
     problem = load("blocks-2")
     actions = plan(problem, semantics="deterministic", seed=0).actions

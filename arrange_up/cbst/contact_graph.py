@@ -64,7 +64,7 @@ from itertools import islice
 
 import networkx as nx
 
-from arrange_up.geometry import Box, HalfWidths, Pose, boxes_overlap
+from arrange_up.geometry.shapes import Box, HalfWidths, Pose, boxes_overlap
 
 __all__ = [
     "FRONT_TOLERANCE",

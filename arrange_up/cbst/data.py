@@ -28,7 +28,8 @@ How an example is drawn (``GenerationSettings`` holds every number):
 * Each rollout draws a state uniformly from the belief (rejecting states where blocks overlap
   each other or the wall: the thesis's non-collision constraint), the paddle's pose noise,
   the friction coefficient uniformly in ``[0.25, 0.55]`` and the part and paddle densities
-  from the block domains' ranges, and simulates the push with :func:`arrange_up.physics.simulate`.
+  from the block domains' ranges, and simulates the push with
+  :func:`arrange_up.physics.simulation.simulate`.
 * Targets over the rollouts that came to rest (the others are counted; an example with fewer
   than 90 % of its rollouts at rest is kept in the file but not trained on): ``dx``, ``dy``,
   ``dθ`` as defined in :mod:`.features`. The largest overshoot of ``x_max`` is recorded too,
@@ -120,7 +121,7 @@ DEFAULT_GENERATION = GenerationSettings()
 @cache
 def _scene(settings: GenerationSettings):
     """The problem the rollouts are simulated in: blocks b0..b{n-1}, a paddle, four walls."""
-    from arrange_up.problem import (
+    from arrange_up.model.problem import (
         ArrangementProblem,
         Goal,
         ObjectKind,
@@ -177,7 +178,7 @@ class _Config:
 
 
 def _draw_config(rng: np.random.Generator, n: int, s: GenerationSettings) -> _Config:
-    from arrange_up.geometry import shadow_box
+    from arrange_up.geometry.shapes import shadow_box
 
     d = s.block_size
     bh = s.domain.block_half
@@ -273,8 +274,8 @@ def generate_example(
     """Example ``index`` of the data set of ``seed`` (module docstring), as a JSON-ready dict:
     ``features`` and ``targets`` (one row per block, paddle side first), ``overshoot`` per
     block, rollout counts and whether the example is ``valid`` (enough rollouts at rest)."""
-    from arrange_up.physics import simulate
-    from arrange_up.world import ActionNoise, Push, WorldState
+    from arrange_up.model.world import ActionNoise, Push, WorldState
+    from arrange_up.physics.simulation import simulate
 
     if rollouts < 1:
         raise ValueError("rollouts must be at least 1")

@@ -58,7 +58,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from arrange_up.geometry import HalfWidths
+from arrange_up.geometry.shapes import HalfWidths
 
 __all__ = [
     "FEATURE_NAMES",

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arrange_up.geometry import Box, HalfWidths, Pose
+from arrange_up.geometry.shapes import Box, HalfWidths, Pose
 
 __all__ = ["CanonicalFrame", "DIRECTION_NAMES"]
 

@@ -17,8 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, Protocol
 
-from arrange_up.problem import ArrangementProblem
-from arrange_up.world import Action
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action
 
 
 class Semantics(Protocol):
@@ -27,7 +27,7 @@ class Semantics(Protocol):
     A semantics may also set ``refuses_uncertain_contacts = True`` (read with ``getattr``,
     default False) when it cannot predict a push whose manipulator may or may not touch a part
     (CBST does so): the planner then also proposes pushes from manipulator positions that miss
-    or wholly cover every part ahead (see :mod:`arrange_up.actions`).
+    or wholly cover every part ahead (see :mod:`arrange_up.planning.actions`).
     """
 
     name: str

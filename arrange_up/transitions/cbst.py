@@ -1,6 +1,6 @@
 """Composable belief-state transitions (CBST, thesis §3.2) on factored interval beliefs.
 
-Beliefs are :class:`~arrange_up.belief.IntervalBelief`: one box ``center ± half`` in
+Beliefs are :class:`~arrange_up.belief.states.IntervalBelief`: one box ``center ± half`` in
 ``(x, y, theta)`` per object on the table, in the problem's object order, rounded to 1e-6
 (angles wrapped into each object's symmetry period around its reference) so that equal
 outcomes compare and hash equal and the search dedupes them.
@@ -44,13 +44,13 @@ from collections import Counter
 
 import numpy as np
 
-from arrange_up.belief import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
+from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
 from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
-from arrange_up.collision import CollisionChecker
-from arrange_up.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
-from arrange_up.world import Action, Pick, Place, Push
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
+from arrange_up.model.world import Action, Pick, Place, Push
 
 __all__ = ["CBSTSemantics"]
 

@@ -29,11 +29,16 @@ from concurrent.futures import Executor
 
 import numpy as np
 
-from arrange_up import geometry
-from arrange_up.belief import AngleFrame, IntervalBelief, ParticleBelief, sample_initial_particles
-from arrange_up.collision import CollisionChecker
-from arrange_up.problem import ArrangementProblem
-from arrange_up.world import (
+from arrange_up.belief.states import (
+    AngleFrame,
+    IntervalBelief,
+    ParticleBelief,
+    sample_initial_particles,
+)
+from arrange_up.geometry import shapes as geometry
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import (
     Action,
     ActionNoise,
     Pick,
@@ -184,7 +189,7 @@ class DeterministicSemantics(ParticleSemantics):
 
 def _simulate_chunk(problem: ArrangementProblem, jobs) -> list[dict] | None:
     """Simulate pushes; the moved poses of each, or None as soon as one fails."""
-    from arrange_up.physics import simulate
+    from arrange_up.physics.simulation import simulate
 
     results = []
     for state, push, noise in jobs:

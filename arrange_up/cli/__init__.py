@@ -1,0 +1,5 @@
+"""The ``arrange-up`` command."""
+
+from arrange_up.cli.commands import main
+
+__all__ = ["main"]

@@ -1,0 +1,1 @@
+"""Pictures: problems, shadows, heat maps and storyboards (matplotlib)."""

@@ -1,0 +1,118 @@
+"""Collision tests on a problem's table: exact footprints for world states, belief shadows for
+action preconditions (thesis §2.1.3).
+
+Shadow tests are the hot path of action generation, so they run in two stages: axis-aligned
+shadow boxes first (numpy, microseconds), and only when two boxes overlap, the exact convex
+shadow hulls (shapely). Both shadows truly cover their object over the whole pose interval, so
+"clear" answers are conservative: a place or push judged clear cannot touch what it was tested
+against, whatever the pose within the intervals.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from functools import lru_cache
+
+from arrange_up.geometry import shapes as geometry
+from arrange_up.model.problem import ArrangementProblem, HalfWidths, Pose
+from arrange_up.model.world import WorldState
+
+#: Overlap area (square inches) below which two footprints count as touching, not overlapping.
+AREA_TOLERANCE = 1e-9
+#: Minimum clearance kept between shadows judged clear (inches): a hair, so that touching
+#: shadows count as a collision and float noise never flips a decision.
+CLEARANCE = 1e-6
+
+
+class CollisionChecker:
+    """Footprint and shadow tests for one problem (walls, obstacles and object shapes fixed)."""
+
+    def __init__(self, problem: ArrangementProblem) -> None:
+        self.problem = problem
+        self.shapes = {spec.name: spec.shape for spec in problem.objects}
+        self.walls = geometry.wall_boxes(problem.table.size, problem.table.walls)
+        self.obstacles = {
+            spec.name: geometry.footprint(spec.shape.parts, spec.pose)
+            for spec in problem.obstacles
+            if spec.pose is not None
+        }
+        self.obstacle_boxes = {name: geom.bounds for name, geom in self.obstacles.items()}
+        self._fixed = list(self.obstacles.values()) + [_box_geom(b) for b in self.walls.values()]
+        self._wall_geoms = {edge: _box_geom(box) for edge, box in self.walls.items()}
+        self._shadow_box = lru_cache(maxsize=200_000)(self._shadow_box_uncached)
+        self._shadow_hull = lru_cache(maxsize=20_000)(self._shadow_hull_uncached)
+
+    # -- world states ------------------------------------------------------------------------
+    def state_collides(self, state: WorldState) -> bool:
+        """True if any two objects of ``state`` overlap, or one overlaps an obstacle or a wall."""
+        footprints = [
+            geometry.footprint(self.shapes[name].parts, pose) for name, pose in state.poses
+        ]
+        for i, a in enumerate(footprints):
+            for b in footprints[i + 1 :] + self._fixed:
+                if a.intersects(b) and a.intersection(b).area > AREA_TOLERANCE:
+                    return True
+        return False
+
+    # -- shadows -----------------------------------------------------------------------------
+    def _shadow_box_uncached(self, name: str, pose: Pose, half: HalfWidths):
+        return geometry.shadow_box(self.shapes[name].parts, pose, half)
+
+    def _shadow_hull_uncached(self, name: str, pose: Pose, half: HalfWidths):
+        return geometry.shadow_hull(self.shapes[name].parts, pose, half)
+
+    def shadow_box(self, name: str, pose: Pose, half: HalfWidths):
+        return self._shadow_box(name, tuple(pose), tuple(half))
+
+    def shadow_hull(self, name: str, pose: Pose, half: HalfWidths):
+        return self._shadow_hull(name, tuple(pose), tuple(half))
+
+    def shadows_overlap(
+        self, a: tuple[str, Pose, HalfWidths], b: tuple[str, Pose, HalfWidths]
+    ) -> bool:
+        """True if the belief shadows of two objects may overlap (boxes, then hulls)."""
+        if not geometry.boxes_overlap(self.shadow_box(*a), self.shadow_box(*b), -CLEARANCE):
+            return False
+        hull_a, hull_b = self.shadow_hull(*a), self.shadow_hull(*b)
+        return hull_a.distance(hull_b) < CLEARANCE
+
+    def shadow_hits_fixed(self, name: str, pose: Pose, half: HalfWidths) -> bool:
+        """True if the object's shadow may touch a wall or an obstacle."""
+        box = self.shadow_box(name, pose, half)
+        hull = None
+        for edge, wall in self.walls.items():
+            if geometry.boxes_overlap(box, wall, -CLEARANCE):
+                hull = hull or self.shadow_hull(name, pose, half)
+                if hull.distance(self._wall_geoms[edge]) < CLEARANCE:
+                    return True
+        for obstacle_name, obstacle in self.obstacles.items():
+            if geometry.boxes_overlap(box, self.obstacle_boxes[obstacle_name], -CLEARANCE):
+                hull = hull or self.shadow_hull(name, pose, half)
+                if hull.distance(obstacle) < CLEARANCE:
+                    return True
+        return False
+
+    def shadow_inside_table(self, name: str, pose: Pose, half: HalfWidths) -> bool:
+        """True if the object's shadow box lies on the table."""
+        xmin, ymin, xmax, ymax = self.shadow_box(name, pose, half)
+        width, depth = self.problem.table.size
+        return xmin >= 0.0 and ymin >= 0.0 and xmax <= width and ymax <= depth
+
+    def shadow_clear(
+        self,
+        name: str,
+        pose: Pose,
+        half: HalfWidths,
+        others: Iterable[tuple[str, Pose, HalfWidths]],
+    ) -> bool:
+        """The place precondition: ``name``'s shadow touches no other shadow, wall or obstacle."""
+        if self.shadow_hits_fixed(name, pose, half):
+            return False
+        candidate = (name, pose, half)
+        return not any(self.shadows_overlap(candidate, other) for other in others)
+
+
+def _box_geom(box):
+    from shapely.geometry import box as shapely_box
+
+    return shapely_box(*box)

@@ -1,0 +1,1018 @@
+"""The PDDL front end: arrangement problems as standard PDDL 2.1 problems.
+
+A ``.pddl`` problem is plain PDDL 2.1 (``:typing``, ``:negative-preconditions``,
+``:numeric-fluents``) over one shared domain, ``semantics/arrange-up-domain.pddl``, which
+unified-planning's ``PDDLReader`` parses unchanged. The vocabulary:
+
+**Types.** ``movable`` (``placeable`` = ``part``, ``fixture``; ``manipulator``) and
+``obstacle``, and below them the *shape types* of the catalogue ``semantics/shapes.yaml``
+(``block-1x1``, ``tee``, ``paddle-short``, ``short-bar``, ...; see
+:mod:`arrange_up.io.shape_catalogue`). Every object is typed by a shape type, which gives both its
+kind and its geometry.
+
+**Functions** (numeric fluents; lengths in inches, angles in degrees):
+
+* ``(x ?o)``, ``(y ?o)``, ``(theta ?o)``: the nominal initial pose of an object on the table
+  (and the fixed pose of an obstacle); ``theta`` defaults to 0.
+* ``(dx ?o)``, ``(dy ?o)``, ``(dtheta ?o)``: the half-widths of its initial uncertainty
+  (default 0).
+* ``(rel-x ?p ?r)``, ``(rel-y ?p ?r)``, ``(rel-theta ?p ?r)``: the pose of part ``?p`` in the
+  frame of part ``?r``, for relative goals.
+* 0-ary: ``(table-width)``, ``(table-depth)`` (required); ``(place-dx)``, ``(place-dy)``,
+  ``(place-dtheta)``, ``(push-dx)``, ``(push-dy)``, ``(push-dtheta)`` (action noise
+  half-widths); ``(friction-min)``, ``(friction-max)``, ``(part-density-min)``,
+  ``(part-density-max)``, ``(manipulator-density-min)``, ``(manipulator-density-max)``
+  (uniform ranges; densities in mass per square inch). Omitted ones take the defaults of
+  :class:`~arrange_up.model.problem.Uncertainty` (no noise, nominal parameters).
+
+**Predicates.** ``(on-table ?o)``: the object starts on the table (objects not listed start
+off it); ``(wall-left)``, ``(wall-right)``, ``(wall-bottom)``, ``(wall-top)``: rigid walls (PDDL's
+closed world: an edge without its predicate has no wall).
+
+**Goals** are one conjunction of ``(on-table P)`` and interval conditions, both bounds per
+dimension: ``(>= (x P) lo) (<= (x P) hi)`` and likewise ``y`` and, unless any angle will do,
+``theta``; or, for a relative goal, the same on ``(rel-x P R)``, ``(rel-y P R)``,
+``(rel-theta P R)`` with one reference part ``R``. Every goal part must have the same
+half-widths (the problem has one tolerance). Angles are understood modulo the part's rotational
+symmetry (a square block turned 90 degrees is the same block).
+
+**Units.** PDDL files are always in **inches and degrees** (the YAML format's defaults; degrees
+keep angles like 15 or 90 exact). Numbers are read exactly (``Fraction``) and converted once.
+
+**Names** are kept as written: unified-planning lowercases PDDL names (PDDL is
+case-insensitive), so :func:`load_pddl_problem` restores the case from the file's ``:objects``
+and problem name. Object names must not repeat a type, function, predicate or action name
+(unified-planning refuses that), nor differ from each other only in case.
+
+**What PDDL cannot express** (:func:`write_pddl_problem` raises :class:`PddlExportError`):
+shapes that are not in the catalogue (or a catalogue shape with another kind), planning hints
+(``planning:``), names that are not PDDL names or that clash as above. The actions' real
+parameters and their physical effects are not in PDDL either: the domain declares place, push
+and pick with their symbolic preconditions only (see its comments); the effects come from the
+semantics (:mod:`arrange_up.up.compile`).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from decimal import Decimal
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from arrange_up.io.shape_catalogue import PDDL_NAME, Catalogue, load_catalogue, semantics_dir
+from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
+from arrange_up.model.problem import (
+    WALL_EDGES,
+    ArrangementProblem,
+    Goal,
+    InitialObject,
+    ObjectKind,
+    ObjectSpec,
+    PlanningHints,
+    Table,
+    Uncertainty,
+)
+from arrange_up.model.units import Units
+
+__all__ = [
+    "DOMAIN_FILE",
+    "DOMAIN_NAME",
+    "PddlExportError",
+    "domain_path",
+    "domain_pddl_text",
+    "load_pddl_problem",
+    "load_pddl_problem_text",
+    "problem_from_up",
+    "write_pddl_problem",
+]
+
+DOMAIN_NAME = "arrange-up"
+DOMAIN_FILE = "arrange-up-domain.pddl"
+#: The units of every PDDL file.
+PDDL_UNITS = Units(length="in", angle="deg")
+
+ABSTRACT_TYPES = ("movable", "placeable", "part", "fixture", "manipulator", "obstacle")
+POSE_FUNCTIONS = ("x", "y", "theta")
+SPREAD_FUNCTIONS = ("dx", "dy", "dtheta")
+RELATIVE_FUNCTIONS = ("rel-x", "rel-y", "rel-theta")
+#: 0-ary functions of the uncertainty, with the ``Uncertainty`` field and index they set.
+NOISE_FUNCTIONS: dict[str, tuple[str, int]] = {
+    "place-dx": ("place", 0),
+    "place-dy": ("place", 1),
+    "place-dtheta": ("place", 2),
+    "push-dx": ("push", 0),
+    "push-dy": ("push", 1),
+    "push-dtheta": ("push", 2),
+    "friction-min": ("friction", 0),
+    "friction-max": ("friction", 1),
+    "part-density-min": ("part_density", 0),
+    "part-density-max": ("part_density", 1),
+    "manipulator-density-min": ("manipulator_density", 0),
+    "manipulator-density-max": ("manipulator_density", 1),
+}
+TABLE_FUNCTIONS = ("table-width", "table-depth")
+WALL_PREDICATES = {f"wall-{edge}": edge for edge in WALL_EDGES}
+ACTIONS = ("place", "push", "pick")
+#: Every name the domain defines; objects must not use them (case-insensitively).
+VOCABULARY = frozenset(
+    ABSTRACT_TYPES
+    + POSE_FUNCTIONS
+    + SPREAD_FUNCTIONS
+    + RELATIVE_FUNCTIONS
+    + tuple(NOISE_FUNCTIONS)
+    + TABLE_FUNCTIONS
+    + tuple(WALL_PREDICATES)
+    + ("on-table", "object", "number")
+    + ACTIONS
+)
+_ANGLE_FUNCTIONS = ("theta", "dtheta", "rel-theta")
+
+
+class PddlExportError(ValueError):
+    """A problem that PDDL cannot express. ``reasons`` lists every obstacle found; ``str()``
+    names the problem and each reason."""
+
+    def __init__(self, problem: str, reasons: Iterable[str]) -> None:
+        self.problem = problem
+        self.reasons = tuple(reasons)
+        lines = "\n".join(f"  - {r}" for r in self.reasons)
+        super().__init__(f"problem {problem!r} cannot be written as PDDL:\n{lines}")
+
+
+# ---------------------------------------------------------------------------------------------
+# the domain
+# ---------------------------------------------------------------------------------------------
+def domain_path() -> Path:
+    """The shipped domain file, ``semantics/arrange-up-domain.pddl``."""
+    return semantics_dir() / DOMAIN_FILE
+
+
+def domain_pddl_text(catalogue: Catalogue | None = None) -> str:
+    """The text of the shared PDDL domain, with the shape types of ``catalogue`` (default: the
+    shipped one). The shipped ``semantics/arrange-up-domain.pddl`` is this text."""
+    catalogue = catalogue if catalogue is not None else load_catalogue()
+    by_kind = {kind: [e.type_name for e in catalogue.of_kind(kind)] for kind in ObjectKind}
+    kind_type = {
+        ObjectKind.PART: "part",
+        ObjectKind.FIXTURE: "fixture",
+        ObjectKind.MANIPULATOR: "manipulator",
+        ObjectKind.OBSTACLE: "obstacle",
+    }
+    shape_lines = [
+        f"    {' '.join(names)} - {kind_type[kind]}" for kind, names in by_kind.items() if names
+    ]
+    return _DOMAIN_TEMPLATE.replace("@SHAPE_TYPES@", "\n".join(shape_lines))
+
+
+_DOMAIN_TEMPLATE = """\
+; The shared action vocabulary of arrange-up problems (PDDL 2.1 with typing and numeric fluents).
+;
+; Every .pddl problem of arrange-up is a problem of this domain. PDDL 2.1 cannot give an action
+; real-valued parameters or effects computed by a physics simulation, so this file declares what
+; PDDL can: the types, the functions and predicates that describe a problem, and the three
+; actions with their symbolic preconditions. What a place or push does to the poses is defined
+; by arrange-up's transition semantics (arrange_up.up.compile.to_up builds the unified-planning
+; model with real parameters and simulated effects).
+;
+; Units: lengths in inches, angles in degrees. Generated from semantics/shapes.yaml by
+; arrange_up.io.pddl.domain_pddl_text(); a test keeps this file and the catalogue in step.
+(define (domain arrange-up)
+  (:requirements :strips :typing :negative-preconditions :numeric-fluents)
+
+  (:types
+    ; movable objects can be on or off the table; obstacles are fixed on it
+    movable obstacle - object
+    placeable manipulator - movable
+    part fixture - placeable
+    ; shape types (semantics/shapes.yaml): each gives an object its kind and its geometry
+@SHAPE_TYPES@
+  )
+
+  (:predicates
+    (on-table ?o - object)   ; in :init, the object starts on the table
+    (wall-left) (wall-right) (wall-bottom) (wall-top)   ; rigid walls along the table's edges
+  )
+
+  (:functions
+    ; nominal pose (x, y in inches; theta in degrees) of an object on the table at the start,
+    ; or of an obstacle; the pose refers to the shape's area centroid
+    (x ?o - object) (y ?o - object) (theta ?o - object)
+    ; half-widths of the initial uncertainty: the pose lies in x +- dx, y +- dy, theta +- dtheta
+    (dx ?o - movable) (dy ?o - movable) (dtheta ?o - movable)
+    ; pose of part ?p in the frame of part ?r (relative goals)
+    (rel-x ?p - part ?r - part) (rel-y ?p - part ?r - part) (rel-theta ?p - part ?r - part)
+    ; the table [0, table-width] x [0, table-depth], inches
+    (table-width) (table-depth)
+    ; action noise: a place lands within the target +- these half-widths, a push's approach pose
+    ; within the commanded one +- these
+    (place-dx) (place-dy) (place-dtheta) (push-dx) (push-dy) (push-dtheta)
+    ; domain parameters, drawn uniformly per action (densities in mass per square inch)
+    (friction-min) (friction-max)
+    (part-density-min) (part-density-max)
+    (manipulator-density-min) (manipulator-density-max)
+  )
+
+  ; place ?o at a pose (real parameters x, y, theta in the arrange-up model): the object must be
+  ; off the table. Where it lands, and what it touches, is up to the semantics.
+  (:action place
+    :parameters (?o - placeable)
+    :precondition (not (on-table ?o))
+    :effect (on-table ?o))
+
+  ; push with ?m from an approach pose over a distance (real parameters in the arrange-up
+  ; model): the manipulator is put down, driven perpendicular to its long side and lifted off
+  ; again, so it must start off the table. Its effect on the poses is the semantics' physics.
+  (:action push
+    :parameters (?m - manipulator)
+    :precondition (not (on-table ?m))
+    :effect (and))
+
+  ; pick ?o off the table (no uncertainty)
+  (:action pick
+    :parameters (?o - movable)
+    :precondition (on-table ?o)
+    :effect (not (on-table ?o)))
+)
+"""
+
+
+# ---------------------------------------------------------------------------------------------
+# writing
+# ---------------------------------------------------------------------------------------------
+def write_pddl_problem(problem: ArrangementProblem, catalogue: Catalogue | None = None) -> str:
+    """The PDDL text of ``problem`` (inches and degrees; see the module docstring).
+
+    Raises :class:`PddlExportError` listing everything PDDL cannot express.
+
+    >>> from arrange_up.io.domains import load
+    >>> text = write_pddl_problem(load("blocks-1"))
+    >>> "(:domain arrange-up)" in text and "A - block-1x1" in text
+    True
+    """
+    catalogue = catalogue if catalogue is not None else load_catalogue()
+    reasons: list[str] = []
+    if not PDDL_NAME.fullmatch(problem.name):
+        reasons.append(
+            f"the problem name {problem.name!r} is not a PDDL name (a letter, then letters, "
+            "digits, '-' or '_')"
+        )
+    types: dict[str, str] = {}
+    seen: dict[str, str] = {}
+    type_names = {t.lower() for t in catalogue.type_names}
+    for spec in problem.objects:
+        key = spec.name.lower()
+        if not PDDL_NAME.fullmatch(spec.name):
+            reasons.append(
+                f"object {spec.name!r}: not a PDDL name (a letter, then letters, digits, '-' "
+                "or '_')"
+            )
+        elif key in VOCABULARY or key in type_names:
+            reasons.append(
+                f"object {spec.name!r}: the name is taken by the PDDL vocabulary (a type, "
+                "function, predicate or action of the arrange-up domain); unified-planning "
+                "refuses an object named like one"
+            )
+        elif key in seen:
+            reasons.append(
+                f"objects {seen[key]!r} and {spec.name!r}: names differ only in case, which "
+                "PDDL (case-insensitive) cannot tell apart"
+            )
+        seen.setdefault(key, spec.name)
+        entry = catalogue.match(spec.kind, spec.shape)
+        if entry is None:
+            known = ", ".join(e.type_name for e in catalogue.of_kind(spec.kind)) or "none"
+            reasons.append(
+                f"object {spec.name!r}: its shape ({_describe_shape(spec.shape)}) is not a "
+                f"{spec.kind.value} shape of the catalogue {catalogue.path} (its "
+                f"{spec.kind.value} types: {known}); add it there to write this problem as "
+                "PDDL"
+            )
+        else:
+            types[spec.name] = entry.type_name
+    if problem.planning != PlanningHints():
+        used = [
+            name
+            for name in (
+                "place_offsets",
+                "place_angles",
+                "push_distances",
+                "push_directions",
+                "max_nodes",
+            )
+            if getattr(problem.planning, name) is not None
+        ]
+        reasons.append(
+            f"planning hints ({', '.join('planning.' + u for u in used)}): PDDL has no place "
+            "for them"
+        )
+    goal = problem.goal
+    if goal.tolerance[2] is None and any(pose[2] != 0 for _, pose in goal.targets):
+        reasons.append(
+            "the goal allows any angle but its targets give angles: PDDL states no theta "
+            "condition then, so it cannot carry them (set the target angles to 0)"
+        )
+    if reasons:
+        raise PddlExportError(problem.name, reasons)
+    return _render(problem, types)
+
+
+def _render(problem: ArrangementProblem, types: dict[str, str]) -> str:
+    deg = PDDL_UNITS.angle_out
+    lines = [
+        f"; {problem.name}: an arrange-up problem in PDDL 2.1 for the domain "
+        f"{DOMAIN_NAME} ({DOMAIN_FILE}).",
+        "; Units: inches and degrees. Written by arrange_up.io.pddl.write_pddl_problem.",
+    ]
+    if problem.description:
+        lines += _comment_block("description: " + " ".join(problem.description.split()))
+    lines += [f"(define (problem {problem.name})", f"  (:domain {DOMAIN_NAME})", "  (:objects"]
+    lines += [f"    {spec.name} - {types[spec.name]}" for spec in problem.objects]
+    lines += ["  )", "  (:init"]
+    table = problem.table
+    walls = ", ".join(table.walls) if table.walls else "none"
+    lines.append(f"    ; the table, {_num(table.width)} x {_num(table.depth)} in; walls: {walls}")
+    lines.append(f"    (= (table-width) {_num(table.width)}) (= (table-depth) {_num(table.depth)})")
+    if table.walls:
+        lines.append("    " + " ".join(f"(wall-{edge})" for edge in table.walls))
+    unc = problem.uncertainty
+    lines.append("    ; action noise (half-widths) and domain parameter ranges")
+    noise = []
+    for name, (attr, index) in NOISE_FUNCTIONS.items():
+        value = getattr(unc, attr)[index]
+        noise.append(f"(= ({name}) {_num(deg(value) if name.endswith('theta') else value)})")
+    lines += ["    " + " ".join(noise[:3]), "    " + " ".join(noise[3:6])]
+    lines += ["    " + " ".join(noise[i : i + 2]) for i in (6, 8, 10)]
+    obstacles = problem.obstacles
+    if obstacles:
+        lines.append("    ; obstacles (fixed)")
+        for spec in obstacles:
+            assert spec.pose is not None
+            lines.append(f"    (on-table {spec.name}) {_pose_facts(spec.name, spec.pose)}")
+    if problem.initial:
+        lines.append("    ; objects on the table at the start: nominal pose and uncertainty")
+        for entry in problem.initial:
+            lines.append(f"    (on-table {entry.name}) {_pose_facts(entry.name, entry.pose)}")
+            dx, dy, dtheta = entry.uncertainty
+            lines.append(
+                f"      (= (dx {entry.name}) {_num(dx)}) (= (dy {entry.name}) {_num(dy)}) "
+                f"(= (dtheta {entry.name}) {_num(deg(dtheta))})"
+            )
+    lines += ["  )", "  (:goal (and"]
+    goal = problem.goal
+    tol_x, tol_y, tol_theta = goal.tolerance
+    if goal.reference is not None:
+        lines.append(f"    (on-table {goal.reference})")
+    for part, (tx, ty, ttheta) in goal.targets:
+        if goal.reference is None:
+            fx, fy, ftheta = (f"({f} {part})" for f in POSE_FUNCTIONS)
+        else:
+            fx, fy, ftheta = (f"({f} {part} {goal.reference})" for f in RELATIVE_FUNCTIONS)
+        lines.append(f"    (on-table {part})")
+        lines.append("    " + _interval(fx, tx, tol_x))
+        lines.append("    " + _interval(fy, ty, tol_y))
+        if tol_theta is not None:
+            lines.append("    " + _interval(ftheta, deg(ttheta), deg(tol_theta)))
+    lines += ["  ))", ")", ""]
+    return "\n".join(lines)
+
+
+def _pose_facts(name: str, pose: tuple[float, float, float]) -> str:
+    x, y, theta = pose
+    return (
+        f"(= (x {name}) {_num(x)}) (= (y {name}) {_num(y)}) "
+        f"(= (theta {name}) {_num(PDDL_UNITS.angle_out(theta))})"
+    )
+
+
+def _interval(fluent: str, target: float, tol: float) -> str:
+    t, d = Decimal(_num(target)), Decimal(_num(tol))
+    return f"(>= {fluent} {_decimal(t - d)}) (<= {fluent} {_decimal(t + d)})"
+
+
+def _num(value: float) -> str:
+    """A number as a plain PDDL decimal (no exponent), to 12 significant digits."""
+    return _decimal(Decimal(f"{float(value):.12g}"))
+
+
+def _decimal(value: Decimal) -> str:
+    text = format(value, "f")
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
+def _comment_block(text: str, width: int = 96) -> list[str]:
+    import textwrap
+
+    wrapped = textwrap.wrap(text, width=width - 4) or [""]
+    return ["; " + wrapped[0]] + [";   " + line for line in wrapped[1:]]
+
+
+def _describe_shape(shape: Any) -> str:
+    if shape.box is not None:
+        return f"box {_num(shape.box[0])} x {_num(shape.box[1])} in"
+    name = f" {shape.name!r}" if shape.name else ""
+    vertices = sum(len(p) for p in shape.parts)
+    return f"polygon{name} with {vertices} vertices in {len(shape.parts)} convex parts"
+
+
+# ---------------------------------------------------------------------------------------------
+# reading
+# ---------------------------------------------------------------------------------------------
+def load_pddl_problem(path: str | Path, domain: str | Path | None = None) -> ArrangementProblem:
+    """Load a ``.pddl`` problem of the arrange-up domain (default: the shipped domain file).
+
+    Raises :class:`~arrange_up.model.errors.ProblemFormatError` whose diagnostics name the file,
+    the line and column where they can (UP's reader reports little; the offending object or
+    fluent is looked up in the text) and what was expected.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise ProblemFormatError(
+            [Diagnostic(source, None, None, "", "no such file; expected a .pddl problem file")]
+        ) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ProblemFormatError(
+            [Diagnostic(source, None, None, "", f"cannot read the file: {error}")]
+        ) from None
+    return load_pddl_problem_text(text, source, domain=domain)
+
+
+def load_pddl_problem_text(
+    text: str, source: str = "<text>", domain: str | Path | None = None
+) -> ArrangementProblem:
+    """Like :func:`load_pddl_problem`, for PDDL ``text`` named ``source`` in messages."""
+    from unified_planning.io import PDDLReader
+
+    domain_file = Path(domain) if domain is not None else domain_path()
+    domain_text = domain_file.read_text(encoding="utf-8")
+    located = _Text(text)
+    declared = located.domain_name()
+    if declared is not None and declared.lower() != DOMAIN_NAME:
+        line, column = located.find(r"\(\s*:domain\s+" + re.escape(declared))
+        raise ProblemFormatError(
+            [
+                Diagnostic(
+                    source,
+                    line,
+                    column,
+                    ":domain",
+                    f"the problem is for domain {declared!r}; expected {DOMAIN_NAME!r} "
+                    f"(arrange-up reads problems of its own domain, {DOMAIN_FILE})",
+                )
+            ]
+        )
+    try:
+        up_problem = PDDLReader().parse_problem_string(domain_text, text)
+    except Exception as error:  # UP raises many kinds; each becomes one diagnostic
+        raise ProblemFormatError([_reader_diagnostic(error, source, located)]) from None
+    return problem_from_up(up_problem, source=source, text=text)
+
+
+def problem_from_up(
+    up_problem: Any, *, source: str | None = None, text: str | None = None
+) -> ArrangementProblem:
+    """Rebuild an :class:`ArrangementProblem` from a UP problem in the PDDL vocabulary (as
+    ``PDDLReader`` makes it from a problem of the arrange-up domain).
+
+    ``text`` (the problem's PDDL source) restores the names' written case and locates
+    diagnostics; without it names stay as UP holds them (lowercase). Raises
+    :class:`~arrange_up.model.errors.ProblemFormatError` listing every problem found.
+    """
+    source = source or f"<unified-planning problem {up_problem.name}>"
+    builder = _Builder(up_problem, source, _Text(text) if text is not None else None)
+    problem = builder.build()
+    errors = [d for d in builder.diagnostics if d.is_error]
+    if errors or problem is None:
+        if not errors:  # pragma: no cover - every refusal records an error
+            builder.error("", "", "the problem could not be rebuilt")
+        raise ProblemFormatError(sort_diagnostics(builder.diagnostics))
+    return problem
+
+
+class _Text:
+    """The PDDL source of a problem: names as written, and positions of things in it."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        # comments blanked out (same length, so positions stay valid)
+        self.code = re.sub(r";[^\n]*", lambda m: " " * len(m.group(0)), text)
+
+    def position(self, index: int) -> tuple[int, int]:
+        before = self.text[:index]
+        return before.count("\n") + 1, index - (before.rfind("\n") + 1) + 1
+
+    def find(self, pattern: str) -> tuple[int | None, int | None]:
+        match = re.search(pattern, self.code, flags=re.IGNORECASE)
+        return self.position(match.start()) if match else (None, None)
+
+    def domain_name(self) -> str | None:
+        match = re.search(r"\(\s*:domain\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
+        return match.group(1) if match else None
+
+    def problem_name(self) -> str | None:
+        match = re.search(r"\(\s*problem\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
+        return match.group(1) if match else None
+
+    def object_names(self) -> list[str]:
+        """Object names in the ``:objects`` section, as written, in order."""
+        match = re.search(r"\(\s*:objects\b", self.code, flags=re.IGNORECASE)
+        if not match:
+            return []
+        depth, end = 1, match.end()
+        while end < len(self.code) and depth:
+            depth += {"(": 1, ")": -1}.get(self.code[end], 0)
+            end += 1
+        tokens = self.code[match.end() : end - 1].split()
+        names, skip = [], False
+        for token in tokens:
+            if skip:
+                skip = False
+            elif token == "-":
+                skip = True
+            else:
+                names.append(token)
+        return names
+
+    def description(self) -> str:
+        """The ``; description:`` comment block written by :func:`write_pddl_problem`."""
+        lines = self.text.splitlines()
+        for i, line in enumerate(lines):
+            if line.startswith("; description:"):
+                parts = [line[len("; description:") :].strip()]
+                for more in lines[i + 1 :]:
+                    if not more.startswith(";   "):
+                        break
+                    parts.append(more[4:].strip())
+                return " ".join(parts)
+        return ""
+
+
+def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnostic:
+    line = column = None
+    message = str(error).strip() or type(error).__name__
+    if hasattr(error, "lineno") and hasattr(error, "col"):  # pyparsing's ParseException
+        line, column = int(error.lineno), int(error.col)
+        message = f"not valid PDDL: {getattr(error, 'msg', message)}"
+    elif isinstance(error, KeyError):
+        name = str(error.args[0]) if error.args else "?"
+        line, column = located.find(rf"(?<![\w-]){re.escape(name)}(?![\w-])")
+        message = (
+            f"unknown name {name!r}: not a type, function or object of the {DOMAIN_NAME} "
+            f"domain ({DOMAIN_FILE}); object types must be shape types of "
+            f"{load_catalogue().path} ({', '.join(load_catalogue().type_names)})"
+        )
+    else:
+        found = re.search(r"line:?\s*(\d+),\s*col:?\s*(\d+)", message)
+        if found:
+            line, column = int(found.group(1)), int(found.group(2))
+        message = f"unified-planning's PDDL reader refused the problem: {message}"
+    return Diagnostic(source, line, column, "", message)
+
+
+@dataclass
+class _Builder:
+    """Rebuilds an :class:`ArrangementProblem` from a UP problem in the PDDL vocabulary."""
+
+    up: Any
+    source: str
+    located: _Text | None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.catalogue = load_catalogue()
+        written = self.located.object_names() if self.located is not None else []
+        self.case = {name.lower(): name for name in written}
+
+    # -- diagnostics ---------------------------------------------------------------------
+    def error(self, path: str, pattern: str, message: str, severity: str = "error") -> None:
+        line = column = None
+        if self.located is not None and pattern:
+            line, column = self.located.find(pattern)
+        self.diagnostics.append(
+            Diagnostic(self.source, line, column, path, message, severity)  # type: ignore[arg-type]
+        )
+
+    def name(self, up_name: str) -> str:
+        return self.case.get(up_name.lower(), up_name)
+
+    # -- the whole problem -----------------------------------------------------------------
+    def build(self) -> ArrangementProblem | None:
+        kinds, objects = self.objects()
+        values = self.initial_values(kinds)
+        table = self.table(values)
+        uncertainty = self.uncertainty(values)
+        initial, obstacles = self.poses(values, kinds)
+        goal = self.goal(kinds)
+        if any(d.is_error for d in self.diagnostics):
+            return None
+        assert table is not None and uncertainty is not None and goal is not None
+        specs = tuple(
+            ObjectSpec(spec.name, spec.kind, spec.shape, obstacles.get(spec.name))
+            for spec in objects
+        )
+        name = self.up.name
+        if self.located is not None:
+            name = self.located.problem_name() or name
+        problem = ArrangementProblem(
+            name=name,
+            table=table,
+            objects=specs,
+            initial=tuple(initial),
+            goal=goal,
+            uncertainty=uncertainty,
+            description=self.located.description() if self.located is not None else "",
+            units=PDDL_UNITS,
+            source=self.source,
+        )
+        self.check_placement(problem)
+        return None if any(d.is_error for d in self.diagnostics) else problem
+
+    # -- objects ---------------------------------------------------------------------------
+    def objects(self) -> tuple[dict[str, ObjectKind], list[ObjectSpec]]:
+        kinds: dict[str, ObjectKind] = {}
+        specs: list[ObjectSpec] = []
+        order = {name.lower(): i for i, name in enumerate(self.case.values())}
+        up_objects = sorted(self.up.all_objects, key=lambda o: order.get(o.name.lower(), 1 << 30))
+        for obj in up_objects:
+            name = self.name(obj.name)
+            type_name = obj.type.name
+            entry = self.catalogue.entry(type_name)
+            if entry is None:
+                self.error(
+                    f"objects.{name}",
+                    rf"(?<![\w-]){re.escape(obj.name)}\s+-",
+                    f"object {name} has type {type_name!r}; expected a shape type of the "
+                    f"catalogue {self.catalogue.path} ({', '.join(self.catalogue.type_names)})",
+                )
+                continue
+            kinds[name] = entry.kind
+            specs.append(ObjectSpec(name, entry.kind, entry.shape))
+        if not specs and not any(d.is_error for d in self.diagnostics):
+            self.error("objects", r"\(\s*:objects", "no objects; expected at least one part")
+        return kinds, specs
+
+    # -- :init -----------------------------------------------------------------------------
+    def initial_values(self, kinds: dict[str, ObjectKind]) -> dict[tuple[str, ...], Any]:
+        """``(function, arg, ...) -> value`` (Fraction or bool) of every explicit value."""
+        out: dict[tuple[str, ...], Any] = {}
+        for fluent_exp, value in self.up.explicit_initial_values.items():
+            key = (fluent_exp.fluent().name, *(self.name(a.object().name) for a in fluent_exp.args))
+            if value.is_bool_constant():
+                out[key] = value.bool_constant_value()
+            else:
+                out[key] = Fraction(value.constant_value())
+        return out
+
+    def number(self, values: dict, key: tuple[str, ...], default: Fraction | None) -> Any:
+        value = values.get(key, default)
+        if value is None:
+            return None
+        return Fraction(value)
+
+    def table(self, values: dict) -> Table | None:
+        size = []
+        for name in TABLE_FUNCTIONS:
+            value = values.get((name,))
+            if value is None:
+                self.error(
+                    "init",
+                    r"\(\s*:init",
+                    f"missing ({name}); expected the table's size in inches, e.g. (= ({name}) 10)",
+                )
+            elif value <= 0:
+                self.error(
+                    f"init.{name}",
+                    rf"\(\s*{name}\s*\)",
+                    f"({name}) is {_num(float(value))}; expected a positive size in inches",
+                )
+            else:
+                size.append(float(value))
+        walls = tuple(edge for pred, edge in WALL_PREDICATES.items() if values.get((pred,)))
+        return Table((size[0], size[1]), walls) if len(size) == 2 else None
+
+    def uncertainty(self, values: dict) -> Uncertainty | None:
+        defaults = Uncertainty()
+        fields: dict[str, list[float]] = {
+            attr: list(getattr(defaults, attr)) for attr, _ in NOISE_FUNCTIONS.values()
+        }
+        given: dict[str, set[int]] = {attr: set() for attr in fields}
+        ok = True
+        for name, (attr, index) in NOISE_FUNCTIONS.items():
+            value = values.get((name,))
+            if value is None:
+                continue
+            if value < 0:
+                self.error(
+                    f"init.{name}",
+                    rf"\(\s*{name}\s*\)",
+                    f"({name}) is {_num(float(value))}; expected a value >= 0",
+                )
+                ok = False
+                continue
+            fields[attr][index] = self.convert(name, value)
+            given[attr].add(index)
+        for attr in ("friction", "part_density", "manipulator_density"):
+            stem = attr.replace("_", "-")
+            if len(given[attr]) == 1:
+                self.error(
+                    "init",
+                    rf"\(\s*{stem}-(min|max)\s*\)",
+                    f"only one of ({stem}-min) and ({stem}-max) is given; expected both (a "
+                    "uniform range) or neither (the default)",
+                )
+                ok = False
+            elif fields[attr][0] > fields[attr][1]:
+                self.error(
+                    "init",
+                    rf"\(\s*{stem}-min\s*\)",
+                    f"({stem}-min) is above ({stem}-max); expected min <= max",
+                )
+                ok = False
+        if not ok:
+            return None
+        return Uncertainty(**{attr: tuple(v) for attr, v in fields.items()})  # type: ignore[arg-type]
+
+    @staticmethod
+    def convert(function: str, value: Fraction) -> float:
+        """A PDDL number (inches, degrees) in internal units (inches, radians)."""
+        if function in _ANGLE_FUNCTIONS or function.endswith("dtheta"):
+            return PDDL_UNITS.angle_in(float(value))
+        return float(value)
+
+    def poses(
+        self, values: dict, kinds: dict[str, ObjectKind]
+    ) -> tuple[list[InitialObject], dict[str, tuple[float, float, float]]]:
+        initial: list[InitialObject] = []
+        obstacles: dict[str, tuple[float, float, float]] = {}
+        on_table = [key[1] for key, v in values.items() if key[0] == "on-table" and v is True]
+        for name, kind in kinds.items():
+            if kind is ObjectKind.OBSTACLE and name not in on_table:
+                on_table.append(name)
+        for name in on_table:
+            if name not in kinds:
+                continue
+            pose = []
+            for function in POSE_FUNCTIONS:
+                value = values.get((function, name))
+                if value is None and function == "theta":
+                    value = Fraction(0)
+                if value is None:
+                    self.error(
+                        f"init.{function}({name})",
+                        rf"\(\s*on-table\s+{re.escape(name)}\s*\)",
+                        f"{name} is on the table but has no ({function} {name}); expected its "
+                        f"nominal pose: (= (x {name}) ...) (= (y {name}) ...) and optionally "
+                        f"(= (theta {name}) ...) in degrees",
+                    )
+                    break
+                pose.append(self.convert(function, value))
+            if len(pose) != 3:
+                continue
+            if kinds[name] is ObjectKind.OBSTACLE:
+                obstacles[name] = (pose[0], pose[1], pose[2])
+                continue
+            spread = []
+            for function in SPREAD_FUNCTIONS:
+                value = values.get((function, name), Fraction(0))
+                if value < 0:
+                    self.error(
+                        f"init.{function}({name})",
+                        rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
+                        f"({function} {name}) is {_num(float(value))}; expected a half-width >= 0",
+                    )
+                spread.append(self.convert(function, value))
+            initial.append(
+                InitialObject(name, (pose[0], pose[1], pose[2]), (spread[0], spread[1], spread[2]))
+            )
+        return initial, obstacles
+
+    # -- :goal -----------------------------------------------------------------------------
+    def goal(self, kinds: dict[str, ObjectKind]) -> Goal | None:
+        bounds: dict[str, dict[str, list[Fraction | None]]] = {}
+        references: set[str] = set()
+        functions_used: set[str] = set()
+        ok = True
+        for condition in _conjuncts(self.up.goals):
+            parsed = self.goal_condition(condition)
+            if parsed is None:
+                ok = False
+                continue
+            if parsed == "on-table":
+                continue
+            function, part, reference, low, high = parsed
+            functions_used.add(function)
+            if reference is not None:
+                references.add(reference)
+            slot = bounds.setdefault(part, {}).setdefault(function, [None, None])
+            if low is not None:
+                slot[0] = low if slot[0] is None else max(slot[0], low)
+            if high is not None:
+                slot[1] = high if slot[1] is None else min(slot[1], high)
+        if not ok:
+            return None
+        if not bounds:
+            self.error(
+                "goal",
+                r"\(\s*:goal",
+                "no goal intervals; expected (>= (x P) lo) (<= (x P) hi) and the same for y "
+                "(and theta) of each goal part, or rel-x/rel-y/rel-theta for a relative goal",
+            )
+            return None
+        relative = any(f.startswith("rel-") for f in functions_used)
+        if relative and any(not f.startswith("rel-") for f in functions_used):
+            self.error(
+                "goal",
+                r"\(\s*:goal",
+                "the goal mixes absolute (x, y, theta) and relative (rel-x, rel-y, rel-theta) "
+                "conditions; expected one kind",
+            )
+            return None
+        reference = None
+        if relative:
+            if len(references) != 1:
+                self.error(
+                    "goal",
+                    r"\(\s*:goal",
+                    f"a relative goal has one reference part; found {sorted(references)}",
+                )
+                return None
+            (reference,) = references
+            if kinds.get(reference) is not ObjectKind.PART:
+                self.error(
+                    "goal",
+                    rf"(?<![\w-]){re.escape(reference)}\s*\)",
+                    f"the reference {reference} of a relative goal must be a part",
+                )
+                return None
+        names = RELATIVE_FUNCTIONS if relative else POSE_FUNCTIONS
+        targets = []
+        tolerance: list[Fraction | None] | None = None
+        for part, dims in bounds.items():
+            if kinds.get(part) is not ObjectKind.PART:
+                kind = kinds.get(part)
+                self.error(
+                    f"goal.{part}",
+                    rf"\(\s*[\w-]+\s+{re.escape(part)}[\s)]",
+                    f"a goal for {part}, which is "
+                    f"{'not an object' if kind is None else 'a ' + kind.value}; only parts have "
+                    "goal poses",
+                )
+                ok = False
+                continue
+            if part == reference:
+                self.error(
+                    f"goal.{part}",
+                    "",
+                    f"{part} is the reference of the relative goal and cannot have a pose "
+                    "relative to itself",
+                )
+                ok = False
+                continue
+            target: list[Fraction] = []
+            half: list[Fraction | None] = []
+            for function in names:
+                low, high = dims.get(function, [None, None])
+                if low is None and high is None and function in ("theta", "rel-theta"):
+                    target.append(Fraction(0))
+                    half.append(None)
+                    continue
+                if low is None or high is None:
+                    missing = ">=" if low is None else "<="
+                    self.error(
+                        f"goal.{function}({part})",
+                        rf"\(\s*{function}\s+{re.escape(part)}[\s)]",
+                        f"({function} {part}) has no ({missing} ...) bound; expected both bounds "
+                        "of an interval target +- tolerance",
+                    )
+                    ok = False
+                    break
+                if low > high:
+                    self.error(
+                        f"goal.{function}({part})",
+                        rf"\(\s*{function}\s+{re.escape(part)}[\s)]",
+                        f"({function} {part}) must lie in [{_num(float(low))}, "
+                        f"{_num(float(high))}], an empty interval",
+                    )
+                    ok = False
+                    break
+                target.append((low + high) / 2)
+                half.append((high - low) / 2)
+            else:
+                if tolerance is None:
+                    tolerance = half
+                elif tolerance != half:
+                    self.error(
+                        f"goal.{part}",
+                        rf"\(\s*[\w-]+\s+{re.escape(part)}[\s)]",
+                        f"the goal interval of {part} has half-widths {_halves(half)}, another "
+                        f"part's have {_halves(tolerance)}; expected one tolerance for every "
+                        "goal part (an arrange-up problem has one)",
+                    )
+                    ok = False
+                    continue
+                targets.append(
+                    (
+                        part,
+                        (
+                            float(target[0]),
+                            float(target[1]),
+                            PDDL_UNITS.angle_in(float(target[2])),
+                        ),
+                    )
+                )
+        if not ok or tolerance is None:
+            return None
+        tol_theta = tolerance[2]
+        return Goal(
+            tuple(targets),
+            (
+                float(tolerance[0]),  # type: ignore[arg-type]
+                float(tolerance[1]),  # type: ignore[arg-type]
+                None if tol_theta is None else PDDL_UNITS.angle_in(float(tol_theta)),
+            ),
+            reference,
+        )
+
+    def goal_condition(self, condition: Any) -> Any:
+        """``"on-table"``, ``(function, part, reference, low, high)`` or ``None`` (reported)."""
+        if condition.is_fluent_exp() and condition.fluent().name == "on-table":
+            return "on-table"
+        if condition.is_le() or condition.is_lt() or condition.is_equals():
+            left, right = condition.args
+            if left.is_fluent_exp() and right.is_constant():
+                fluent, value, side = left, Fraction(right.constant_value()), "high"
+            elif right.is_fluent_exp() and left.is_constant():
+                fluent, value, side = right, Fraction(left.constant_value()), "low"
+            else:
+                fluent = None
+            if fluent is not None and fluent.fluent().name in POSE_FUNCTIONS + RELATIVE_FUNCTIONS:
+                function = fluent.fluent().name
+                args = [self.name(a.object().name) for a in fluent.args]
+                reference = args[1] if len(args) == 2 else None
+                if condition.is_equals():
+                    return function, args[0], reference, value, value
+                if side == "high":
+                    return function, args[0], reference, None, value
+                return function, args[0], reference, value, None
+        self.error(
+            "goal",
+            r"\(\s*:goal",
+            f"unsupported goal condition {condition}; expected (on-table P), (>= (x P) lo), "
+            "(<= (x P) hi) and likewise y, theta, or rel-x/rel-y/rel-theta of (P R)",
+        )
+        return None
+
+    # -- checks shared with the YAML loader ------------------------------------------------
+    def check_placement(self, problem: ArrangementProblem) -> None:
+        from arrange_up.geometry import shapes as geometry
+        from arrange_up.io.yaml_problem import AREA_TOLERANCE, BOUNDS_TOLERANCE
+
+        placed = [(spec.name, spec.shape, spec.pose) for spec in problem.obstacles]
+        placed += [(e.name, problem.object(e.name).shape, e.pose) for e in problem.initial]
+        width, depth = problem.table.size
+        footprints = []
+        for name, shape, pose in placed:
+            assert pose is not None
+            footprint = geometry.footprint(shape.parts, pose)
+            xmin, ymin, xmax, ymax = footprint.bounds
+            tol = BOUNDS_TOLERANCE
+            if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
+                self.error(
+                    f"init.x({name})",
+                    rf"\(\s*x\s+{re.escape(name)}\s*\)",
+                    f"{name} lies outside the table: at its nominal pose it spans x "
+                    f"{_num(xmin)}..{_num(xmax)}, y {_num(ymin)}..{_num(ymax)}; expected it "
+                    f"within [0, {_num(width)}] x [0, {_num(depth)}] in",
+                )
+            for other, other_footprint in footprints:
+                overlap = footprint.intersection(other_footprint).area
+                if overlap > AREA_TOLERANCE:
+                    self.error(
+                        f"init.x({name})",
+                        rf"\(\s*x\s+{re.escape(name)}\s*\)",
+                        f"{name} overlaps {other} at their nominal poses (overlap area "
+                        f"{_num(overlap)} in²); expected shapes that touch at most",
+                    )
+            footprints.append((name, footprint))
+
+
+def _conjuncts(goals: Iterable[Any]) -> list[Any]:
+    out = []
+    stack = list(goals)[::-1]
+    while stack:
+        node = stack.pop()
+        if node.is_and():
+            stack.extend(list(node.args)[::-1])
+        else:
+            out.append(node)
+    return out
+
+
+def _halves(half: list[Fraction | None]) -> str:
+    return "[" + ", ".join("any" if h is None else _num(float(h)) for h in half) + "]"

@@ -1,0 +1,226 @@
+"""Plans as values and as documented JSON files.
+
+A plan file (written by ``arrange-up plan --output PLAN.json``, read by ``evaluate``, ``show``
+and ``repair``) is a JSON object::
+
+    {
+      "format": "arrange-up-plan/1",
+      "problem": {"name": "blocks-4", "hash": "sha256:…", "source": "domain:blocks-4"},
+      "units": {"length": "in", "angle": "deg"},
+      "status": "solved",
+      "semantics": "particles", "particles": 50, "seed": 0,
+      "search": {"expanded": 41, "generated": 380, …, "elapsed": 12.3},
+      "actions": [
+        {"type": "place", "object": "A", "pose": [9.1, 0.9, 0.0]},
+        {"type": "push", "manipulator": "paddle", "pose": [9.1, -0.3, 0.0], "distance": 2.0},
+        {"type": "pick", "object": "bar"}
+      ]
+    }
+
+Poses and distances are in the problem's own units (``units``). ``actions`` is present, and
+the plan complete, only when ``status`` is ``"solved"``; any other status records an honest
+failure with its search statistics. ``hash`` identifies the problem's content (see
+:func:`arrange_up.model.problem.problem_hash`); the commands that read plans warn when it does not
+match the problem they are given (:func:`plan_problem_mismatch`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from arrange_up.model.problem import ArrangementProblem, ObjectKind, problem_hash
+from arrange_up.model.units import Units
+from arrange_up.model.world import Action, Pick, Place, Push
+
+PLAN_FORMAT = "arrange-up-plan/1"
+
+
+class PlanFileError(ValueError):
+    """A plan file that cannot be read or does not fit its problem; the message says where."""
+
+
+def action_to_json(action: Action, units: Units) -> dict[str, Any]:
+    """One action as a JSON object in the user's units."""
+    if isinstance(action, Place):
+        return {"type": "place", "object": action.obj, "pose": _pose_out(action.pose, units)}
+    if isinstance(action, Push):
+        return {
+            "type": "push",
+            "manipulator": action.manipulator,
+            "pose": _pose_out(action.pose, units),
+            "distance": _round(units.length_out(action.distance)),
+        }
+    if isinstance(action, Pick):
+        return {"type": "pick", "object": action.obj}
+    raise TypeError(f"not an action: {action!r}")
+
+
+def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where: str) -> Action:
+    """Parse one action object (user units) into an internal action, checked against ``problem``.
+
+    Raises :class:`PlanFileError` naming ``where`` (e.g. ``plan.json: actions[3]``).
+    """
+    if not isinstance(data, Mapping):
+        raise PlanFileError(f"{where}: expected an object with a 'type', got {data!r}")
+    kind = data.get("type")
+    names = {spec.name: spec for spec in problem.objects}
+
+    def name_of(key: str, allowed: tuple[ObjectKind, ...]) -> str:
+        name = data.get(key)
+        if not isinstance(name, str) or name not in names:
+            raise PlanFileError(
+                f"{where}.{key}: expected an object of problem {problem.name!r}, got {name!r}"
+            )
+        if names[name].kind not in allowed:
+            raise PlanFileError(
+                f"{where}.{key}: {name!r} is a {names[name].kind.value}; "
+                f"expected one of {', '.join(k.value for k in allowed)}"
+            )
+        return name
+
+    def pose_of() -> tuple[float, float, float]:
+        pose = data.get("pose")
+        if (
+            not isinstance(pose, Sequence)
+            or isinstance(pose, str)
+            or len(pose) != 3
+            or not all(_is_number(v) for v in pose)
+        ):
+            raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {pose!r}")
+        return units.pose_in(tuple(pose))  # type: ignore[arg-type]
+
+    movable = (ObjectKind.PART, ObjectKind.FIXTURE, ObjectKind.MANIPULATOR)
+    if kind == "place":
+        return Place(name_of("object", (ObjectKind.PART, ObjectKind.FIXTURE)), pose_of())
+    if kind == "push":
+        distance = data.get("distance")
+        if not _is_number(distance) or distance < 0:
+            raise PlanFileError(
+                f"{where}.distance: expected a non-negative number, got {distance!r}"
+            )
+        return Push(
+            name_of("manipulator", (ObjectKind.MANIPULATOR,)), pose_of(), units.length_in(distance)
+        )
+    if kind == "pick":
+        return Pick(name_of("object", movable))
+    raise PlanFileError(f"{where}.type: expected 'place', 'push' or 'pick', got {kind!r}")
+
+
+def plan_document(
+    problem: ArrangementProblem,
+    actions: Sequence[Action] | None,
+    *,
+    status: str,
+    semantics: str,
+    seed: int | None,
+    search: Mapping[str, Any],
+    extra: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """Build the JSON document of a planning result (see the module docstring)."""
+    doc: dict[str, Any] = {
+        "format": PLAN_FORMAT,
+        "problem": {
+            "name": problem.name,
+            "hash": problem_hash(problem),
+            "source": problem.source,
+        },
+        "units": {"length": problem.units.length, "angle": problem.units.angle},
+        "status": status,
+        "semantics": semantics,
+        "seed": seed,
+    }
+    if extra:
+        doc.update(extra)
+    doc["search"] = dict(search)
+    if status == "solved" and actions is not None:
+        doc["actions"] = [action_to_json(a, problem.units) for a in actions]
+    return doc
+
+
+def write_json_atomic(path: Path, document: Mapping[str, Any]) -> Path:
+    """Write JSON to ``path`` atomically: a reader never sees a half-written file."""
+    return write_text_atomic(path, json.dumps(document, indent=2) + "\n")
+
+
+def write_text_atomic(path: Path, text: str) -> Path:
+    """Write ``text`` to ``path`` through a temporary file and a rename, so that a reader (or
+    a crash) never leaves a half-written file behind."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Action, ...], dict]:
+    """Read a plan file for ``problem``; return its actions (internal units) and the document.
+
+    Raises :class:`PlanFileError` for unreadable files, other formats, unsolved plans and
+    actions that do not fit the problem.
+    """
+    path = Path(path)
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise PlanFileError(f"{path}: cannot read plan file: {error.strerror}") from None
+    except json.JSONDecodeError as error:
+        raise PlanFileError(f"{path}:{error.lineno}:{error.colno}: not JSON: {error.msg}") from None
+    if not isinstance(document, dict) or document.get("format") != PLAN_FORMAT:
+        raise PlanFileError(
+            f"{path}: format: expected {PLAN_FORMAT!r}, got "
+            f"{document.get('format') if isinstance(document, dict) else document!r}"
+        )
+    if document.get("status") != "solved" or "actions" not in document:
+        raise PlanFileError(
+            f"{path}: status: the plan is {document.get('status')!r}, not "
+            "'solved'; it holds no actions to use"
+        )
+    raw_units = document.get("units", {})
+    try:
+        units = Units(raw_units.get("length", "in"), raw_units.get("angle", "deg"))
+    except (AttributeError, ValueError) as error:
+        raise PlanFileError(f"{path}: units: {error}") from None
+    raw_actions = document["actions"]
+    if not isinstance(raw_actions, list):
+        raise PlanFileError(f"{path}: actions: expected a list")
+    actions = tuple(
+        action_from_json(item, units, problem, f"{path}: actions[{i}]")
+        for i, item in enumerate(raw_actions)
+    )
+    return actions, document
+
+
+def plan_problem_mismatch(document: Mapping[str, Any], problem: ArrangementProblem) -> str | None:
+    """A warning if the plan ``document`` was made for a problem other than ``problem``."""
+    recorded = document.get("problem", {}) if isinstance(document, Mapping) else {}
+    if recorded.get("hash") not in (None, problem_hash(problem)):
+        return (
+            f"it was planned for problem {recorded.get('name')!r} with other content "
+            f"than {problem.name!r} ({recorded.get('hash')} vs {problem_hash(problem)})"
+        )
+    return None
+
+
+def _pose_out(pose: Sequence[float], units: Units) -> list[float]:
+    return [_round(v) for v in units.pose_out(tuple(pose))]  # type: ignore[arg-type]
+
+
+def _round(value: float) -> float:
+    # 12 significant digits: exact enough to replay, free of binary noise like 0.30000000000000004
+    return float(f"{value:.12g}")
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)

@@ -1,0 +1,1416 @@
+"""Load and validate ``.yaml`` problem files (format ``arrange-up/1``).
+
+The format is specified in ``docs/problem-format.md``. This module turns a file into an
+:class:`~arrange_up.model.problem.ArrangementProblem` or refuses it with a
+:class:`~arrange_up.model.errors.ProblemFormatError` that lists *every* problem found in the file,
+each
+naming the file, the 1-based line and column where the offending YAML node starts, the key path
+(``objects.T.shape``, ``initial.C.pose[2]``) and what was expected. A file is never half-loaded:
+a problem is built only when the whole file is valid.
+
+Public functions:
+
+* :func:`load_problem` / :func:`load_problem_text`: the problem, or ``ProblemFormatError``
+  (which carries the errors and, for context, any warnings). Warnings alone never refuse a file.
+* :func:`check_problem`: the problem (or ``None``) and every diagnostic, warnings included,
+  for ``arrange-up check``.
+
+Semantics beyond the bare format, all enforced here:
+
+* **Units** are converted once: lengths to inches, angles to radians, densities (mass per
+  square user length unit) to mass per square inch; friction is dimensionless. The problem keeps
+  the file's :class:`~arrange_up.model.units.Units`. Messages quote values in the file's units.
+* **Shapes** are given in ``shapes:`` (named) or inline in an object's ``shape:`` as exactly one
+  of ``{box: [w, h]}`` (both > 0, centred), ``{polygon: [[x, y], ...]}`` (a simple polygon, may
+  be non-convex: decomposed into convex parts) or ``{convex_parts: [[[x, y], ...], ...]}`` (each
+  part a valid convex polygon; parts may touch but not overlap). Coordinates are in the
+  object's frame; the loader shifts them so the shape's area centroid is the origin, because a
+  pose refers to the centroid. Parts are made counter-clockwise. ``Shape.box`` is set for boxes.
+* **Objects** have identifier names (``[A-Za-z_][A-Za-z0-9_-]*``), a kind (part, manipulator,
+  fixture, obstacle) and a shape. Obstacles need a ``pose`` and appear neither in ``initial`` nor
+  in the goal; other kinds must not have a ``pose`` under ``objects``.
+* **Initial** entries name declared non-obstacle objects, with a ``pose`` and an optional
+  ``uncertainty`` (default ``[0, 0, 0]``, no negative half-widths). ``initial`` itself is
+  optional (nothing on the table). The nominal footprints of initial objects and obstacles must
+  not overlap (intersection area above ``AREA_TOLERANCE`` square inches; touching is fine) and
+  must lie inside the table ``[0, W] x [0, D]`` (within ``BOUNDS_TOLERANCE`` inches).
+* **Goal**: exactly one of ``poses`` (absolute) or ``relative`` (``reference`` plus ``poses``);
+  at least one target; targets are declared parts; a relative goal's reference is a declared
+  part not listed among its own poses. ``tolerance`` is ``[dx, dy]`` (any angle) or
+  ``[dx, dy, dtheta]``, all >= 0; when missing, :data:`DEFAULT_GOAL_TOLERANCE_IN` inches in x and
+  y and any angle is used, with a warning.
+* **Uncertainty**: ``place``/``push`` are three half-widths >= 0; ``friction``,
+  ``part_density`` and ``manipulator_density`` are ``[low, high]`` with ``0 <= low <= high``.
+  Omitted keys take the defaults of :class:`~arrange_up.model.problem.Uncertainty`.
+* **Table**: ``size`` is two positive numbers; ``walls`` a list drawn from left, right, bottom,
+  top without repeats (default all four, ``[]`` for none).
+* **format** is optional and must be ``arrange-up/1``; **name** is a required non-empty string;
+  **description** an optional string.
+* **planning** hints: ``place_offsets`` (``[[dx, dy], ...]``, lengths), ``place_angles``
+  (angles), ``push_distances`` (positive lengths), ``push_directions`` (a subset of +x, -x, +y,
+  -y) and ``max_nodes`` (a positive integer); lists must be non-empty. Unknown keys inside
+  ``planning`` are errors, since a typo there would silently change planning.
+* Unknown keys anywhere else are **warnings** (the format welcomes new optional keys).
+* Every number must be a finite real; booleans are not numbers. Duplicate keys are errors,
+  reported at each duplicate. Problems are collected through the whole file, but follow-on
+  checks are skipped for parts already found invalid (no cascades).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from arrange_up.geometry import shapes as geometry
+from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
+from arrange_up.model.problem import (
+    WALL_EDGES,
+    ArrangementProblem,
+    ConvexPolygon,
+    Goal,
+    InitialObject,
+    ObjectKind,
+    ObjectSpec,
+    PlanningHints,
+    Point,
+    Pose,
+    Shape,
+    Table,
+    Uncertainty,
+)
+from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
+
+__all__ = [
+    "AREA_TOLERANCE",
+    "BOUNDS_TOLERANCE",
+    "DEFAULT_GOAL_TOLERANCE_IN",
+    "FORMAT_VERSION",
+    "SUPPORTED_FORMATS",
+    "check_problem",
+    "check_problem_text",
+    "load_problem",
+    "load_problem_text",
+]
+
+FORMAT_VERSION = "arrange-up/1"
+#: The ``format:`` values this loader reads.
+SUPPORTED_FORMATS: tuple[str, ...] = (FORMAT_VERSION,)
+#: Goal tolerance in x and y (inches, whatever the file's units) when ``goal.tolerance`` is
+#: omitted; the angle is then unconstrained.
+DEFAULT_GOAL_TOLERANCE_IN = 0.2
+#: Overlap area (square inches) above which two shapes count as overlapping; touching is fine.
+AREA_TOLERANCE = 1e-9
+#: How far (inches) a footprint may stick out of the table and still count as inside.
+BOUNDS_TOLERANCE = 1e-9
+
+NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
+TOP_LEVEL_KEYS = (
+    "format",
+    "name",
+    "description",
+    "units",
+    "table",
+    "shapes",
+    "objects",
+    "initial",
+    "goal",
+    "uncertainty",
+    "planning",
+)
+SHAPE_FORMS = ("box", "polygon", "convex_parts")
+SHAPE_EXPECTED = "{box: [w, h]}, {polygon: [...]}, {convex_parts: [...]}"
+PUSH_DIRECTIONS = ("+x", "-x", "+y", "-y")
+PLANNING_KEYS = ("place_offsets", "place_angles", "push_distances", "push_directions", "max_nodes")
+UNCERTAINTY_KEYS = ("place", "push", "friction", "part_density", "manipulator_density")
+KIND_NAMES = tuple(kind.value for kind in ObjectKind)
+_ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
+_ARTICLE["obstacle"] = "an obstacle"
+
+
+# ---------------------------------------------------------------------------------------------
+# public API
+# ---------------------------------------------------------------------------------------------
+def load_problem(path: str | Path) -> ArrangementProblem:
+    """Load a ``.yaml`` problem file.
+
+    Raises :class:`ProblemFormatError` listing every problem found in the file (errors, and any
+    warnings for context) if the file cannot be read or has at least one error.
+    """
+    problem, diagnostics = check_problem(path)
+    if problem is None:
+        raise ProblemFormatError(diagnostics)
+    return problem
+
+
+def load_problem_text(text: str, source: str = "<text>") -> ArrangementProblem:
+    """Load a problem from YAML ``text``; ``source`` names it in messages and on the problem."""
+    problem, diagnostics = check_problem_text(text, source)
+    if problem is None:
+        raise ProblemFormatError(diagnostics)
+    return problem
+
+
+def check_problem(path: str | Path) -> tuple[ArrangementProblem | None, list[Diagnostic]]:
+    """Validate a problem file: ``(problem, diagnostics)``.
+
+    ``problem`` is ``None`` when there is at least one error. ``diagnostics`` holds errors and
+    warnings in file order. Never raises for a bad file.
+    """
+    source = str(path)
+    text, diagnostic = _read_text(Path(path), source)
+    if diagnostic is not None:
+        return None, [diagnostic]
+    assert text is not None
+    return check_problem_text(text, source)
+
+
+def check_problem_text(
+    text: str, source: str = "<text>"
+) -> tuple[ArrangementProblem | None, list[Diagnostic]]:
+    """Like :func:`check_problem`, for YAML ``text`` named ``source`` in messages."""
+    report = _Report(source)
+    problem: ArrangementProblem | None = None
+    try:
+        root = _parse(text, report)
+        if root is not None:
+            problem = _Builder(report).build(root)
+    except Exception as error:  # a safety net: a bug here must not become a traceback
+        report.error(
+            None,
+            "",
+            f"internal error while checking the file ({type(error).__name__}: {error}); "
+            "please report this",
+        )
+    diagnostics = sort_diagnostics(report.diagnostics)
+    if any(d.severity == "error" for d in diagnostics):
+        return None, diagnostics
+    if problem is None:  # pragma: no cover - every refusal records an error
+        return None, diagnostics
+    return problem, diagnostics
+
+
+# ---------------------------------------------------------------------------------------------
+# reading and parsing
+# ---------------------------------------------------------------------------------------------
+def _read_text(path: Path, source: str) -> tuple[str | None, Diagnostic | None]:
+    def fail(message: str, line: int | None = None, column: int | None = None) -> Diagnostic:
+        return Diagnostic(source, line, column, "", message)
+
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return None, fail("no such file; expected a .yaml problem file")
+    except IsADirectoryError:
+        return None, fail("is a directory; expected a .yaml problem file")
+    except PermissionError:
+        return None, fail("cannot read the file: permission denied")
+    except OSError as error:
+        return None, fail(f"cannot read the file: {error.strerror or error}")
+    try:
+        return data.decode("utf-8-sig"), None
+    except UnicodeDecodeError as error:
+        before = data[: error.start]
+        line = before.count(b"\n") + 1
+        column = len(before) - (before.rfind(b"\n") + 1) + 1
+        return None, fail(
+            f"not a text file: byte 0x{data[error.start]:02x} is not UTF-8; expected a YAML "
+            "problem file in UTF-8",
+            line,
+            column,
+        )
+
+
+def _parse(text: str, report: _Report) -> Any:
+    """Parse YAML text with ruamel's round-trip loader (which keeps every node's position).
+
+    Returns the top-level mapping, or ``None`` after recording an error. Duplicate keys are
+    found on the composed node tree, so every duplicate is reported, not just the first.
+    """
+    from ruamel.yaml import YAML
+    from ruamel.yaml.comments import CommentedMap
+    from ruamel.yaml.error import MarkedYAMLError, YAMLError
+    from ruamel.yaml.reader import ReaderError
+
+    yaml = YAML(typ="rt")
+    yaml.allow_duplicate_keys = True  # found and reported by _find_duplicates instead
+    try:
+        node = yaml.compose(text)
+        data = None if node is None else yaml.constructor.construct_document(node)
+    except MarkedYAMLError as error:
+        mark = error.problem_mark or error.context_mark
+        what = str(error.problem or "syntax error")
+        if error.context:
+            what += f" ({error.context})"
+        line = mark.line + 1 if mark is not None else None
+        column = mark.column + 1 if mark is not None else None
+        report.error((line, column), "", f"not valid YAML: {what}")
+        return None
+    except ReaderError as error:  # a character YAML does not allow, such as NUL
+        before = text[: error.position]
+        line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+        report.error(
+            (line, column),
+            "",
+            f"not valid YAML: character {_char(error.character)} is not allowed in a YAML file",
+        )
+        return None
+    except YAMLError as error:
+        report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
+        return None
+    except RecursionError:
+        report.error(None, "", "not a problem file: the YAML is nested too deeply")
+        return None
+
+    if node is None or data is None:
+        report.error(
+            (1, 1),
+            "",
+            "the file is empty; expected a mapping with at least the keys name, table, "
+            "objects and goal",
+        )
+        return None
+    if not isinstance(data, CommentedMap):
+        report.error(
+            (node.start_mark.line + 1, node.start_mark.column + 1),
+            "",
+            f"not a problem file: the top level is {_describe(data)}; expected a mapping with "
+            "at least the keys name, table, objects and goal",
+        )
+        return None
+    for line, column, path, key, first in _find_duplicates(node):
+        report.error(
+            (line, column),
+            path,
+            f"duplicate key {key!r} (first given at line {first[0]}, column {first[1]}); each "
+            "key may appear only once in a mapping",
+        )
+    return data
+
+
+def _find_duplicates(root: Any) -> Iterator[tuple[int, int, str, str, tuple[int, int]]]:
+    """Every duplicate key in a composed node tree.
+
+    Yields ``(line, column, path, key, (first line, first column))``, 1-based.
+    """
+    from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
+
+    seen: set[int] = set()
+    stack: list[tuple[Any, str]] = [(root, "")]
+    while stack:
+        node, path = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, MappingNode):
+            first: dict[tuple[str, str], tuple[int, int]] = {}
+            for key_node, value_node in node.value:
+                if isinstance(key_node, ScalarNode):
+                    key_path = _join(path, key_node.value)
+                    ident = (str(key_node.tag), str(key_node.value))
+                    if ident[0].endswith(":merge"):
+                        pass
+                    elif ident in first:
+                        mark = key_node.start_mark
+                        yield mark.line + 1, mark.column + 1, key_path, ident[1], first[ident]
+                    else:
+                        mark = key_node.start_mark
+                        first[ident] = (mark.line + 1, mark.column + 1)
+                else:
+                    key_path = _join(path, "?")
+                stack.append((value_node, key_path))
+        elif isinstance(node, SequenceNode):
+            for index, item in enumerate(node.value):
+                stack.append((item, f"{path}[{index}]"))
+
+
+# ---------------------------------------------------------------------------------------------
+# diagnostics and located values
+# ---------------------------------------------------------------------------------------------
+Location = tuple[int | None, int | None]
+
+
+class _Report:
+    """Collects diagnostics for one source."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+        self.diagnostics: list[Diagnostic] = []
+
+    def _add(self, where: _Node | Location | None, path: str | None, message: str, sev: str):
+        if isinstance(where, _Node):
+            line, column = where.line, where.column
+            path = where.path if path is None else path
+        elif where is None:
+            line, column = None, None
+        else:
+            line, column = where
+        self.diagnostics.append(Diagnostic(self.source, line, column, path or "", message, sev))  # type: ignore[arg-type]
+
+    def error(self, where: _Node | Location | None, path: str | None, message: str) -> None:
+        self._add(where, path, message, "error")
+
+    def warning(self, where: _Node | Location | None, path: str | None, message: str) -> None:
+        self._add(where, path, message, "warning")
+
+    @property
+    def error_count(self) -> int:
+        return sum(1 for d in self.diagnostics if d.severity == "error")
+
+
+@dataclass
+class _Node:
+    """A value from the YAML tree with its 1-based position and key path."""
+
+    value: Any
+    line: int | None
+    column: int | None
+    path: str
+
+    @property
+    def is_map(self) -> bool:
+        return isinstance(self.value, dict)
+
+    @property
+    def is_seq(self) -> bool:
+        return isinstance(self.value, list)
+
+    @property
+    def is_null(self) -> bool:
+        return self.value is None
+
+    def has(self, key: str) -> bool:
+        return self.is_map and key in self.value
+
+    def key(self, key: Any) -> _Node:
+        """The key itself, positioned where the key is written."""
+        line, column = _lc(self.value, "key", key, (self.line, self.column))
+        return _Node(key, line, column, _join(self.path, key))
+
+    def child(self, key: Any) -> _Node:
+        """The value under ``key`` (positioned at the key when the value is empty)."""
+        value = self.value[key]
+        if value is None:
+            line, column = _lc(self.value, "key", key, (self.line, self.column))
+        else:
+            line, column = _lc(self.value, "value", key, (self.line, self.column))
+        return _Node(value, line, column, _join(self.path, key))
+
+    def entries(self) -> list[tuple[_Node, _Node]]:
+        return [(self.key(k), self.child(k)) for k in self.value]
+
+    def items(self) -> list[_Node]:
+        nodes = []
+        for index, value in enumerate(self.value):
+            line, column = _lc(self.value, "item", index, (self.line, self.column))
+            nodes.append(_Node(value, line, column, f"{self.path}[{index}]"))
+        return nodes
+
+    def missing(self, key: str) -> _Node:
+        """Where to report a missing ``key``: the start of this mapping, at the key's path."""
+        return _Node(None, self.line, self.column, _join(self.path, key))
+
+
+def _lc(container: Any, kind: str, key: Any, default: Location) -> Location:
+    """1-based position of a key/value/item from ruamel's line-column records."""
+    try:
+        line, column = getattr(container.lc, kind)(key)
+        return line + 1, column + 1
+    except Exception:  # merged keys and constructed values have no record
+        return default
+
+
+def _join(path: str, key: Any) -> str:
+    return f"{path}.{key}" if path else str(key)
+
+
+def _at(node: _Node) -> str:
+    return f"line {node.line}, column {node.column}"
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def _fmt(value: float) -> str:
+    return f"{value:g}"
+
+
+def _describe(value: Any) -> str:
+    """How a YAML value reads in a message: "'abc' (a string)", "a list", ..."""
+    from ruamel.yaml.scalarbool import ScalarBoolean
+
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool | ScalarBoolean):
+        return f"{str(bool(value)).lower()} (a boolean)"
+    if isinstance(value, str):
+        return f"{str(value)!r} (a string)"
+    if isinstance(value, int | float):
+        return f"the number {value}"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, list):
+        return "a list"
+    return f"a {type(value).__name__} value"
+
+
+def _is_number(value: Any) -> bool:
+    from ruamel.yaml.scalarbool import ScalarBoolean
+
+    return isinstance(value, int | float) and not isinstance(value, bool | ScalarBoolean)
+
+
+def _suggest(key: Any, known: Sequence[str]) -> str:
+    if not isinstance(key, str):
+        return ""
+    close = difflib.get_close_matches(key, known, n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+# ---------------------------------------------------------------------------------------------
+# the builder: one method per section, each recording problems and returning None when invalid
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class _Object:
+    """An object as far as it could be read (``None`` fields were invalid and reported)."""
+
+    name: str
+    node: _Node
+    kind: ObjectKind | None = None
+    shape: Shape | None = None
+    pose: Pose | None = None
+    pose_node: _Node | None = None
+    ok: bool = True
+
+
+@dataclass
+class _Placed:
+    """A shape at a nominal pose, for the overlap and table checks."""
+
+    name: str
+    shape: Shape
+    pose: Pose
+    node: _Node
+    footprint: Any = field(default=None)
+
+
+class _Builder:
+    def __init__(self, report: _Report) -> None:
+        self.report = report
+        self.units = Units()
+
+    # -- helpers --------------------------------------------------------------------------------
+    def error(self, node: _Node, message: str) -> None:
+        self.report.error(node, None, message)
+
+    def warn_unknown(self, node: _Node, known: Sequence[str], where: str) -> None:
+        """Warn about keys of mapping ``node`` not in ``known``."""
+        for key_node, _ in node.entries():
+            if key_node.value not in known:
+                self.report.warning(
+                    key_node,
+                    None,
+                    f"unknown key {key_node.value!r} in {where} is ignored"
+                    f"{_suggest(key_node.value, known)}; known keys: {', '.join(known)}",
+                )
+
+    def required(self, node: _Node, key: str, expected: str) -> _Node | None:
+        """The child ``key`` of mapping ``node``; when it is missing, report "missing required
+        key; expected ``expected``" at the mapping and return None."""
+        if node.has(key):
+            return node.child(key)
+        self.error(node.missing(key), f"missing required key; expected {expected}")
+        return None
+
+    def mapping(self, node: _Node, expected: str, *, null_ok: bool = False) -> bool:
+        if node.is_map or (null_ok and node.is_null):
+            return True
+        self.error(node, f"expected {expected}, got {_describe(node.value)}")
+        return False
+
+    def string(self, node: _Node, expected: str = "a string") -> str | None:
+        if isinstance(node.value, str) and node.value.strip():
+            return str(node.value)
+        self.error(node, f"expected {expected}, got {_describe(node.value)}")
+        return None
+
+    def number(self, node: _Node, what: str = "a number") -> float | None:
+        value = node.value
+        if _is_number(value):
+            try:
+                result = float(value)
+            except OverflowError:
+                result = math.inf
+            if math.isfinite(result):
+                return result
+        self.error(node, f"expected {what} (a finite number), got {_describe(value)}")
+        return None
+
+    def vector(self, node: _Node, *forms: Sequence[str]) -> tuple[float, ...] | None:
+        """A list of numbers whose length matches one of ``forms`` (their labels)."""
+        expected = " or ".join(f"[{', '.join(labels)}]" for labels in forms)
+        if not node.is_seq or len(node.value) not in {len(f) for f in forms}:
+            got = _describe(node.value)
+            if node.is_seq:
+                got = f"a list of {len(node.value)} value{'s' if len(node.value) != 1 else ''}"
+            self.error(node, f"expected {expected}, got {got}")
+            return None
+        labels = next(f for f in forms if len(f) == len(node.value))
+        values = [self.number(item, labels[i]) for i, item in enumerate(node.items())]
+        if any(v is None for v in values):
+            return None
+        return tuple(values)  # type: ignore[arg-type]
+
+    def non_negative(
+        self, node: _Node, values: tuple[float, ...] | None, what: str
+    ) -> tuple[float, ...] | None:
+        return self._signed(node, values, what, allow_zero=True)
+
+    def positive(
+        self, node: _Node, values: tuple[float, ...] | None, what: str
+    ) -> tuple[float, ...] | None:
+        return self._signed(node, values, what, allow_zero=False)
+
+    def _signed(
+        self, node: _Node, values: tuple[float, ...] | None, what: str, *, allow_zero: bool
+    ) -> tuple[float, ...] | None:
+        """``values`` (read from list ``node``) if each is >= 0 (> 0 unless ``allow_zero``),
+        else None after reporting every offending item."""
+        if values is None:
+            return None
+        ok = True
+        for item, value in zip(node.items(), values, strict=True):
+            if value < 0 or (value == 0 and not allow_zero):
+                sign = "negative" if value < 0 else "zero"
+                bound = ">= 0" if allow_zero else "> 0"
+                self.error(item, f"{sign} {what} {_fmt(value)}; expected a value {bound}")
+                ok = False
+        return values if ok else None
+
+    def pose(self, node: _Node) -> Pose | None:
+        values = self.vector(node, ("x", "y", "theta"))
+        return None if values is None else self.units.pose_in(values)  # type: ignore[arg-type]
+
+    def half_widths(self, node: _Node) -> tuple[float, float, float] | None:
+        values = self.vector(node, ("dx", "dy", "dtheta"))
+        values = self.non_negative(node, values, "half-width")
+        return None if values is None else self.units.pose_in(values)  # type: ignore[arg-type]
+
+    def list_of(self, node: _Node, expected: str) -> list[_Node] | None:
+        if not node.is_seq or not node.value:
+            got = "an empty list" if node.is_seq else _describe(node.value)
+            self.error(node, f"expected {expected}, got {got}")
+            return None
+        return node.items()
+
+    # -- the whole file ----------------------------------------------------------------------
+    def build(self, data: Any) -> ArrangementProblem | None:
+        # Missing top-level keys are reported where the mapping starts (its first key).
+        line, column = _lc(data, "key", next(iter(data)), (1, 1)) if data else (1, 1)
+        root = _Node(data, line, column, "")
+        self.warn_unknown(root, TOP_LEVEL_KEYS, "the problem")
+
+        self.format(root)
+        name = self.name(root)
+        description = self.description(root)
+        if root.has("units"):
+            self.units = self.read_units(root.child("units"))
+        table = self.table(root)
+        shapes = self.shapes(root)
+        objects = self.objects(root, shapes)
+        initial = self.initial(root, objects)
+        self.check_placement(table, objects, initial)
+        goal = self.goal(root, objects)
+        uncertainty = self.uncertainty(root)
+        planning = self.planning(root)
+
+        if self.report.error_count:
+            return None
+        assert name is not None and table is not None and goal is not None
+        assert uncertainty is not None and planning is not None
+        specs = tuple(
+            ObjectSpec(o.name, o.kind, o.shape, o.pose)  # type: ignore[arg-type]
+            for o in objects.values()
+        )
+        return ArrangementProblem(
+            name=name,
+            table=table,
+            objects=specs,
+            initial=tuple(entry for entry, _ in initial),
+            goal=goal,
+            uncertainty=uncertainty,
+            planning=planning,
+            description=description or "",
+            units=self.units,
+            source=self.report.source,
+        )
+
+    # -- format, name, description, units -------------------------------------------------------
+    def format(self, root: _Node) -> None:
+        if not root.has("format"):
+            return
+        node = root.child("format")
+        if node.value not in SUPPORTED_FORMATS:
+            shown = repr(node.value) if isinstance(node.value, str) else _describe(node.value)
+            self.error(
+                node,
+                f"unsupported format {shown}; this loader reads {', '.join(SUPPORTED_FORMATS)}",
+            )
+
+    def name(self, root: _Node) -> str | None:
+        node = self.required(root, "name", "the problem's name (a string)")
+        if node is None:
+            return None
+        return self.string(node, "the problem's name (a non-empty string)")
+
+    def description(self, root: _Node) -> str | None:
+        if not root.has("description") or root.child("description").is_null:
+            return ""
+        node = root.child("description")
+        if isinstance(node.value, str):
+            return str(node.value)
+        self.error(node, f"expected a string, got {_describe(node.value)}")
+        return None
+
+    def read_units(self, node: _Node) -> Units:
+        if not self.mapping(node, "a mapping like {length: cm, angle: rad}", null_ok=True):
+            return Units()
+        if node.is_null:
+            return Units()
+        self.warn_unknown(node, ("length", "angle"), "'units'")
+        length, angle = "in", "deg"
+        for key, table, default in (("length", LENGTH_UNITS, "in"), ("angle", ANGLE_UNITS, "deg")):
+            if not node.has(key):
+                continue
+            child = node.child(key)
+            if isinstance(child.value, str) and child.value in table:
+                if key == "length":
+                    length = str(child.value)
+                else:
+                    angle = str(child.value)
+            else:
+                shown = (
+                    repr(child.value) if isinstance(child.value, str) else _describe(child.value)
+                )
+                self.error(
+                    child,
+                    f"unknown {key} unit {shown}; expected one of {' | '.join(table)} "
+                    f"(default {default})",
+                )
+        return Units(length, angle)
+
+    # -- table ----------------------------------------------------------------------------------
+    def table(self, root: _Node) -> Table | None:
+        node = self.required(root, "table", "{size: [width, depth], walls: [...]}")
+        if node is None:
+            return None
+        if not self.mapping(node, "a mapping {size: [width, depth], walls: [...]}"):
+            return None
+        self.warn_unknown(node, ("size", "walls"), "'table'")
+        size = None
+        if node.has("size"):
+            size_node = node.child("size")
+            size = self.positive(size_node, self.vector(size_node, ("width", "depth")), "size")
+        else:
+            self.error(node.missing("size"), "missing required key; expected [width, depth]")
+        walls: tuple[str, ...] | None = WALL_EDGES
+        if node.has("walls"):
+            walls = self.walls(node.child("walls"))
+        if size is None or walls is None:
+            return None
+        lf = self.units.length_factor
+        return Table((size[0] * lf, size[1] * lf), walls)
+
+    def walls(self, node: _Node) -> tuple[str, ...] | None:
+        expected = f"a list of edges drawn from {', '.join(WALL_EDGES)} ([] for none)"
+        if not node.is_seq:
+            self.error(node, f"expected {expected}, got {_describe(node.value)}")
+            return None
+        chosen: dict[str, _Node] = {}
+        ok = True
+        for item in node.items():
+            if item.value not in WALL_EDGES:
+                self.error(
+                    item,
+                    f"unknown wall {_describe(item.value)}; expected one of "
+                    f"{', '.join(WALL_EDGES)}",
+                )
+                ok = False
+            elif item.value in chosen:
+                self.error(
+                    item,
+                    f"wall {item.value!r} is listed twice (first at {_at(chosen[item.value])}); "
+                    "list each edge at most once",
+                )
+                ok = False
+            else:
+                chosen[str(item.value)] = item
+        return tuple(e for e in WALL_EDGES if e in chosen) if ok else None
+
+    # -- shapes ---------------------------------------------------------------------------------
+    def shapes(self, root: _Node) -> dict[str, Shape | None]:
+        """Named shapes; a name maps to ``None`` when its shape was invalid (already reported)."""
+        shapes: dict[str, Shape | None] = {}
+        if not root.has("shapes"):
+            return shapes
+        node = root.child("shapes")
+        if not self.mapping(node, "a mapping from shape names to shapes", null_ok=True):
+            return shapes
+        if node.is_null:
+            return shapes
+        for key_node, value_node in node.entries():
+            if not isinstance(key_node.value, str):
+                self.error(
+                    key_node, f"expected a shape name (a string), got {_describe(key_node.value)}"
+                )
+                continue
+            shapes[str(key_node.value)] = self.shape_form(value_node, str(key_node.value))
+        return shapes
+
+    def shape_form(self, node: _Node, name: str | None) -> Shape | None:
+        """A shape given as ``{box: ...}``, ``{polygon: ...}`` or ``{convex_parts: ...}``."""
+        if not node.is_map:
+            self.error(
+                node, f"expected a shape: one of {SHAPE_EXPECTED}; got {_describe(node.value)}"
+            )
+            return None
+        self.warn_unknown(node, SHAPE_FORMS, "a shape")
+        forms = [key for key in SHAPE_FORMS if node.has(key)]
+        if not forms:
+            self.error(
+                node,
+                f"a shape needs exactly one of box, polygon or convex_parts; "
+                f"expected one of {SHAPE_EXPECTED}",
+            )
+            return None
+        if len(forms) > 1:
+            self.error(
+                node.key(forms[1]),
+                f"a shape has exactly one of box, polygon or convex_parts; found both "
+                f"{forms[0]!r} and {forms[1]!r}",
+            )
+            return None
+        form = forms[0]
+        child = node.child(form)
+        if form == "box":
+            return self.box(child, name)
+        if form == "polygon":
+            return self.polygon(child, name)
+        return self.convex_parts(child, name)
+
+    def box(self, node: _Node, name: str | None) -> Shape | None:
+        size = self.positive(node, self.vector(node, ("width", "height")), "box size")
+        if size is None:
+            return None
+        width, height = (self.units.length_in(v) for v in size)
+        parts = (_as_polygon(geometry.ensure_ccw(geometry.box_polygon(width, height))),)
+        return Shape(parts, box=(width, height), name=name)
+
+    def points(self, node: _Node) -> list[Point] | None:
+        """A polygon's vertices ``[[x, y], ...]`` (at least three), converted to inches."""
+        if not node.is_seq or len(node.value) < 3:
+            got = _describe(node.value)
+            if node.is_seq:
+                got = f"{len(node.value)} vertices"
+            self.error(
+                node, f"expected a polygon [[x, y], ...] with at least 3 vertices, got {got}"
+            )
+            return None
+        values = [self.vector(item, ("x", "y")) for item in node.items()]
+        if any(v is None for v in values):
+            return None
+        points = [(self.units.length_in(v[0]), self.units.length_in(v[1])) for v in values]  # type: ignore[index]
+        if len(points) > 3 and points[-1] == points[0]:
+            points.pop()  # an explicitly closed outline: the closing vertex repeats the first
+        return points
+
+    def valid_polygon(self, node: _Node, points: list[Point], what: str) -> bool:
+        try:
+            reason = geometry.polygon_problem(tuple(points))
+        except Exception as error:  # geometry must not leak a traceback for odd input
+            reason = f"cannot be analysed ({error})"
+        if reason:
+            self.error(
+                node,
+                f"{what} {reason}; expected a simple polygon (vertices in order around its "
+                "boundary, no self-intersections, non-zero area)",
+            )
+            return False
+        return True
+
+    def polygon(self, node: _Node, name: str | None) -> Shape | None:
+        points = self.points(node)
+        if points is None or not self.valid_polygon(node, points, "the polygon"):
+            return None
+        try:
+            parts = tuple(
+                _as_polygon(geometry.ensure_ccw(p))
+                for p in geometry.decompose_convex(geometry.ensure_ccw(tuple(points)))
+            )
+        except Exception as error:
+            self.error(node, f"the polygon could not be decomposed into convex parts ({error})")
+            return None
+        return self.centred(parts, name)
+
+    def convex_parts(self, node: _Node, name: str | None) -> Shape | None:
+        items = self.list_of(node, "a non-empty list of convex polygons [[[x, y], ...], ...]")
+        if items is None:
+            return None
+        parts: list[tuple[int, _Node, ConvexPolygon]] = []
+        ok = True
+        for index, item in enumerate(items):
+            points = self.points(item)
+            if points is None or not self.valid_polygon(item, points, f"part [{index}]"):
+                ok = False
+                continue
+            if not geometry.is_convex(tuple(points)):
+                self.error(
+                    item,
+                    f"part [{index}] is not convex; expected convex polygons (use 'polygon:' "
+                    "to have a non-convex shape decomposed for you)",
+                )
+                ok = False
+                continue
+            parts.append((index, item, _as_polygon(geometry.ensure_ccw(tuple(points)))))
+        area_unit = self.units.length_factor**2
+        for j in range(len(parts)):
+            for i in range(j):
+                (index_i, _, part_i), (index_j, node_j, part_j) = parts[i], parts[j]
+                overlap = _overlap_area((part_i,), (0.0, 0.0, 0.0), (part_j,), (0.0, 0.0, 0.0))
+                if overlap > AREA_TOLERANCE:
+                    self.error(
+                        node_j,
+                        f"parts [{index_i}] and [{index_j}] overlap (area "
+                        f"{_fmt(overlap / area_unit)} {self.units.length}²); the convex parts of "
+                        "a shape may touch but not overlap",
+                    )
+                    ok = False
+        if not ok:
+            return None
+        return self.centred(tuple(p for _, _, p in parts), name)
+
+    @staticmethod
+    def centred(parts: tuple[ConvexPolygon, ...], name: str | None) -> Shape:
+        cx, cy = geometry.parts_centroid(parts)
+        shifted = tuple(_as_polygon(geometry.translate_polygon(p, -cx, -cy)) for p in parts)
+        return Shape(shifted, name=name)
+
+    # -- objects --------------------------------------------------------------------------------
+    def objects(self, root: _Node, shapes: dict[str, Shape | None]) -> dict[str, _Object]:
+        objects: dict[str, _Object] = {}
+        node = self.required(
+            root, "objects", "a mapping from object names to {kind: ..., shape: ...}"
+        )
+        if node is None:
+            return objects
+        if not node.is_map or not node.value:
+            got = "an empty mapping" if node.is_map else _describe(node.value)
+            self.error(
+                node,
+                f"expected a mapping from object names to {{kind: ..., shape: ...}}, got {got}",
+            )
+            return objects
+        for key_node, value_node in node.entries():
+            name = key_node.value
+            if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
+                shown = repr(name) if isinstance(name, str) else _describe(name)
+                self.error(
+                    key_node,
+                    f"invalid object name {shown}; expected an identifier: letters, digits, "
+                    "'_' and '-', starting with a letter or '_'",
+                )
+                if not isinstance(name, str):
+                    continue
+                obj = _Object(str(name), value_node, ok=False)
+            else:
+                obj = _Object(str(name), value_node)
+            objects[obj.name] = obj
+            self.object(obj, value_node, shapes)
+        return objects
+
+    def object(self, obj: _Object, node: _Node, shapes: dict[str, Shape | None]) -> None:
+        if not self.mapping(node, "a mapping {kind: ..., shape: ...}"):
+            obj.ok = False
+            return
+        self.warn_unknown(node, ("kind", "shape", "pose"), "an object")
+        if node.has("kind"):
+            kind_node = node.child("kind")
+            if kind_node.value in KIND_NAMES:
+                obj.kind = ObjectKind(kind_node.value)
+            else:
+                shown = (
+                    repr(kind_node.value)
+                    if isinstance(kind_node.value, str)
+                    else _describe(kind_node.value)
+                )
+                self.error(
+                    kind_node,
+                    f"unknown object kind {shown}; expected one of {', '.join(KIND_NAMES)}",
+                )
+        else:
+            self.error(
+                node.missing("kind"),
+                f"missing required key; expected one of {', '.join(KIND_NAMES)}",
+            )
+        if node.has("shape"):
+            obj.shape = self.object_shape(node.child("shape"), shapes)
+        else:
+            self.error(
+                node.missing("shape"),
+                f"missing required key; expected the name of a "
+                f"shape declared under 'shapes' or an inline {SHAPE_EXPECTED}",
+            )
+        if obj.kind is ObjectKind.OBSTACLE:
+            if node.has("pose"):
+                obj.pose_node = node.child("pose")
+                obj.pose = self.pose(obj.pose_node)
+            else:
+                self.error(
+                    node.missing("pose"),
+                    "missing required key; an obstacle never moves "
+                    "and needs its pose [x, y, theta] here",
+                )
+        elif obj.kind is not None and node.has("pose"):
+            self.error(
+                node.key("pose"),
+                f"only obstacles have a pose under 'objects'; {obj.name} is "
+                f"{_ARTICLE[obj.kind.value]}: give its starting pose under 'initial' (or leave "
+                "it out to start it off the table)",
+            )
+        if obj.kind is None or obj.shape is None:
+            obj.ok = False
+        if obj.kind is ObjectKind.OBSTACLE and obj.pose is None:
+            obj.ok = False
+
+    def object_shape(self, node: _Node, shapes: dict[str, Shape | None]) -> Shape | None:
+        if isinstance(node.value, str):
+            name = str(node.value)
+            if name in shapes:
+                return shapes[name]  # None if invalid: reported where it is declared
+            declared = ", ".join(shapes)
+            choices = (
+                f"one of the shapes declared under 'shapes' ({declared}) or an inline "
+                if shapes
+                else "an inline "
+            )
+            extra = "" if shapes else " (no shapes are declared under 'shapes')"
+            self.error(node, f"unknown shape {name!r}; expected {choices}{SHAPE_EXPECTED}{extra}")
+            return None
+        if node.is_map:
+            return self.shape_form(node, None)
+        self.error(
+            node,
+            f"expected the name of a shape declared under 'shapes' or an inline "
+            f"{SHAPE_EXPECTED}; got {_describe(node.value)}",
+        )
+        return None
+
+    def declared(self, key_node: _Node, objects: dict[str, _Object], where: str) -> _Object | None:
+        """The object a key names, or ``None`` after reporting an undeclared name."""
+        name = key_node.value
+        if isinstance(name, str) and name in objects:
+            return objects[name]
+        shown = repr(name) if isinstance(name, str) else _describe(name)
+        declared = ", ".join(objects) or "none"
+        self.error(
+            key_node,
+            f"{shown} in {where} is not declared under 'objects'; "
+            f"expected one of the declared objects ({declared})",
+        )
+        return None
+
+    # -- initial --------------------------------------------------------------------------------
+    def initial(
+        self, root: _Node, objects: dict[str, _Object]
+    ) -> list[tuple[InitialObject, _Node]]:
+        """The valid initial entries (invalid ones are reported and left out)."""
+        entries: list[tuple[InitialObject, _Node]] = []
+        if not root.has("initial"):
+            return entries
+        node = root.child("initial")
+        expected = "a mapping from object names to {pose: [x, y, theta]}"
+        if not self.mapping(node, expected, null_ok=True) or node.is_null:
+            return entries
+        for key_node, value_node in node.entries():
+            obj = self.declared(key_node, objects, "'initial'")
+            if obj is not None and obj.kind is ObjectKind.OBSTACLE:
+                self.error(
+                    key_node,
+                    f"{obj.name} is an obstacle, which is fixed at the pose given under "
+                    "'objects'; expected only parts, manipulators and fixtures in 'initial'",
+                )
+                obj = None
+            entry = self.initial_entry(value_node, str(key_node.value))
+            if obj is not None and entry is not None:
+                entries.append((entry, value_node))
+        return entries
+
+    def initial_entry(self, node: _Node, name: str) -> InitialObject | None:
+        if not self.mapping(node, "a mapping {pose: [x, y, theta], uncertainty: [dx, dy, dtheta]}"):
+            return None
+        self.warn_unknown(node, ("pose", "uncertainty"), "an initial entry")
+        pose = None
+        if node.has("pose"):
+            pose = self.pose(node.child("pose"))
+        else:
+            self.error(node.missing("pose"), "missing required key; expected [x, y, theta]")
+        uncertainty: tuple[float, float, float] | None = (0.0, 0.0, 0.0)
+        if node.has("uncertainty"):
+            uncertainty = self.half_widths(node.child("uncertainty"))
+        if pose is None:
+            return None
+        # An invalid uncertainty is already reported; the pose still takes part in the
+        # placement checks so that all problems are found in one pass.
+        return InitialObject(name, pose, uncertainty or (0.0, 0.0, 0.0))
+
+    def check_placement(
+        self,
+        table: Table | None,
+        objects: dict[str, _Object],
+        initial: list[tuple[InitialObject, _Node]],
+    ) -> None:
+        """Nominal footprints of initial objects and obstacles: on the table, not overlapping.
+
+        Objects whose shape, kind or pose is invalid are skipped (already reported).
+        """
+        placed: list[_Placed] = []
+        for obj in objects.values():
+            if obj.ok and obj.kind is ObjectKind.OBSTACLE:
+                assert obj.shape is not None and obj.pose is not None and obj.pose_node
+                placed.append(_Placed(obj.name, obj.shape, obj.pose, obj.pose_node))
+        for entry, node in initial:
+            obj = objects[entry.name]
+            if obj.ok and obj.shape is not None:
+                placed.append(_Placed(entry.name, obj.shape, entry.pose, node.child("pose")))
+        placed.sort(key=lambda p: (p.node.line or 0, p.node.column or 0))
+        for item in placed:
+            item.footprint = geometry.footprint(item.shape.parts, item.pose)
+
+        units = self.units
+        if table is not None:
+            width, depth = table.size
+            for item in placed:
+                xmin, ymin, xmax, ymax = item.footprint.bounds
+                tol = BOUNDS_TOLERANCE
+                if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
+                    spans = ", ".join(
+                        f"{axis} {_fmt(units.length_out(lo))}..{_fmt(units.length_out(hi))}"
+                        for axis, lo, hi in (("x", xmin, xmax), ("y", ymin, ymax))
+                    )
+                    self.error(
+                        item.node,
+                        f"{item.name} lies outside the table: at this nominal pose its shape "
+                        f"spans {spans}; expected it within the table [0, "
+                        f"{_fmt(units.length_out(width))}] x [0, "
+                        f"{_fmt(units.length_out(depth))}] {units.length}",
+                    )
+        area_unit = units.length_factor**2
+        for j, later in enumerate(placed):
+            for earlier in placed[:j]:
+                overlap = later.footprint.intersection(earlier.footprint).area
+                if overlap > AREA_TOLERANCE:
+                    self.error(
+                        later.node,
+                        f"{later.name} overlaps {earlier.name} ({earlier.node.path}, line "
+                        f"{earlier.node.line}) at their nominal poses (overlap area "
+                        f"{_fmt(overlap / area_unit)} {units.length}²); expected shapes that "
+                        "touch at most",
+                    )
+
+    # -- goal -----------------------------------------------------------------------------------
+    def goal(self, root: _Node, objects: dict[str, _Object]) -> Goal | None:
+        node = self.required(
+            root,
+            "goal",
+            "a mapping with exactly one of 'poses' or 'relative', and a 'tolerance'",
+        )
+        if node is None:
+            return None
+        if not self.mapping(
+            node, "a mapping with 'tolerance' and exactly one of 'poses' or 'relative'"
+        ):
+            return None
+        self.warn_unknown(node, ("tolerance", "poses", "relative"), "'goal'")
+
+        tolerance: tuple[float, float, float | None] | None
+        if node.has("tolerance"):
+            tolerance = self.tolerance(node.child("tolerance"))
+        else:
+            tolerance = (DEFAULT_GOAL_TOLERANCE_IN, DEFAULT_GOAL_TOLERANCE_IN, None)
+            self.report.warning(
+                node.missing("tolerance"),
+                None,
+                f"no tolerance given; using the default [{DEFAULT_GOAL_TOLERANCE_IN}, "
+                f"{DEFAULT_GOAL_TOLERANCE_IN}] inches with any angle",
+            )
+
+        has_poses, has_relative = node.has("poses"), node.has("relative")
+        if has_poses and has_relative:
+            self.error(
+                node.key("relative"),
+                "a goal has exactly one of 'poses' (absolute) or 'relative'; found both",
+            )
+            return None
+        if not has_poses and not has_relative:
+            self.error(
+                node.missing("poses"),
+                "missing; expected exactly one of 'poses' "
+                "(absolute goal) or 'relative' (goal relative to a reference part)",
+            )
+            return None
+
+        reference: str | None = None
+        if has_relative:
+            relative = node.child("relative")
+            if not self.mapping(relative, "a mapping {reference: PART, poses: {...}}"):
+                return None
+            self.warn_unknown(relative, ("reference", "poses"), "'goal.relative'")
+            reference = self.reference(relative, objects)
+            if not relative.has("poses"):
+                self.error(
+                    relative.missing("poses"),
+                    "missing required key; expected a mapping "
+                    "from part names to poses [x, y, theta] in the reference's frame",
+                )
+                return None
+            targets = self.targets(relative.child("poses"), objects, reference)
+            if reference is None:
+                return None
+        else:
+            targets = self.targets(node.child("poses"), objects, None)
+        if targets is None or tolerance is None:
+            return None
+        return Goal(targets, tolerance, reference)
+
+    def tolerance(self, node: _Node) -> tuple[float, float, float | None] | None:
+        values = self.vector(node, ("dx", "dy"), ("dx", "dy", "dtheta"))
+        values = self.non_negative(node, values, "tolerance")
+        if values is None:
+            return None
+        dx, dy = self.units.length_in(values[0]), self.units.length_in(values[1])
+        return (dx, dy, self.units.angle_in(values[2]) if len(values) == 3 else None)
+
+    def reference(self, relative: _Node, objects: dict[str, _Object]) -> str | None:
+        node = self.required(relative, "reference", "the name of a declared part")
+        if node is None:
+            return None
+        if not isinstance(node.value, str):
+            self.error(node, f"expected the name of a declared part, got {_describe(node.value)}")
+            return None
+        obj = self.declared(node, objects, "'goal.relative.reference'")
+        if obj is None:
+            return None
+        if obj.kind is None:
+            return None
+        if obj.kind is not ObjectKind.PART:
+            self.error(
+                node,
+                f"the reference of a relative goal must be a part; {obj.name} is "
+                f"{_ARTICLE[obj.kind.value]}",
+            )
+            return None
+        return obj.name
+
+    def targets(
+        self, node: _Node, objects: dict[str, _Object], reference: str | None
+    ) -> tuple[tuple[str, Pose], ...] | None:
+        if not node.is_map or not node.value:
+            got = "an empty mapping" if node.is_map else _describe(node.value)
+            self.error(
+                node, f"expected a mapping from part names to poses [x, y, theta], got {got}"
+            )
+            return None
+        targets: list[tuple[str, Pose]] = []
+        ok = True
+        where = "'goal.relative.poses'" if node.path.endswith("relative.poses") else "the goal"
+        for key_node, value_node in node.entries():
+            obj = self.declared(key_node, objects, where)
+            if obj is not None and obj.kind is not None and obj.kind is not ObjectKind.PART:
+                self.error(
+                    key_node,
+                    f"a goal for a non-part: {obj.name} is {_ARTICLE[obj.kind.value]}; only "
+                    "parts have goal poses",
+                )
+                obj = None
+            elif obj is not None and obj.name == reference:
+                self.error(
+                    key_node,
+                    f"{obj.name} is the reference of this relative goal and cannot have a pose "
+                    "relative to itself; expected only the other parts here",
+                )
+                obj = None
+            pose = self.pose(value_node)
+            if obj is None or pose is None or obj.kind is None:
+                ok = False
+                continue
+            targets.append((obj.name, pose))
+        return tuple(targets) if ok else None
+
+    # -- uncertainty ----------------------------------------------------------------------------
+    def uncertainty(self, root: _Node) -> Uncertainty | None:
+        default = Uncertainty()
+        if not root.has("uncertainty"):
+            return default
+        node = root.child("uncertainty")
+        if not self.mapping(
+            node, "a mapping with any of " + ", ".join(UNCERTAINTY_KEYS), null_ok=True
+        ):
+            return None
+        if node.is_null:
+            return default
+        self.warn_unknown(node, UNCERTAINTY_KEYS, "'uncertainty'")
+        values: dict[str, Any] = {}
+        ok = True
+        for key in ("place", "push"):
+            if node.has(key):
+                values[key] = self.half_widths(node.child(key))
+                ok &= values[key] is not None
+        units = self.units
+        for key, convert in (
+            ("friction", float),
+            ("part_density", units.density_in),
+            ("manipulator_density", units.density_in),
+        ):
+            if node.has(key):
+                values[key] = self.range(node.child(key), convert)
+                ok &= values[key] is not None
+        return Uncertainty(**values) if ok else None
+
+    def range(self, node: _Node, convert: Callable[[float], float]) -> tuple[float, float] | None:
+        values = self.non_negative(node, self.vector(node, ("low", "high")), "value")
+        if values is None:
+            return None
+        low, high = values
+        if low > high:
+            self.error(
+                node,
+                f"low {_fmt(low)} is above high {_fmt(high)}; expected [low, high] "
+                "with 0 <= low <= high",
+            )
+            return None
+        return (convert(low), convert(high))
+
+    # -- planning hints -------------------------------------------------------------------------
+    def planning(self, root: _Node) -> PlanningHints | None:
+        if not root.has("planning"):
+            return PlanningHints()
+        node = root.child("planning")
+        if not self.mapping(
+            node, "a mapping of planning hints (" + ", ".join(PLANNING_KEYS) + ")", null_ok=True
+        ):
+            return None
+        if node.is_null:
+            return PlanningHints()
+        ok = True
+        for key_node, _ in node.entries():
+            if key_node.value not in PLANNING_KEYS:
+                self.error(
+                    key_node,
+                    f"unknown planning hint {key_node.value!r}"
+                    f"{_suggest(key_node.value, PLANNING_KEYS)}; expected one of "
+                    f"{', '.join(PLANNING_KEYS)} (a misspelt hint would silently change "
+                    "planning)",
+                )
+                ok = False
+        hints: dict[str, Any] = {}
+        units = self.units
+        if node.has("place_offsets"):
+            items = self.list_of(node.child("place_offsets"), "a non-empty list of [dx, dy]")
+            offsets = None if items is None else [self.vector(i, ("dx", "dy")) for i in items]
+            if offsets is None or any(o is None for o in offsets):
+                ok = False
+            else:
+                hints["place_offsets"] = tuple(
+                    (units.length_in(o[0]), units.length_in(o[1]))  # type: ignore[index]
+                    for o in offsets
+                )
+        if node.has("place_angles"):
+            numbers = self.numbers(node.child("place_angles"), "angle", positive=False)
+            ok &= numbers is not None
+            if numbers is not None:
+                hints["place_angles"] = tuple(units.angle_in(v) for v in numbers)
+        if node.has("push_distances"):
+            numbers = self.numbers(node.child("push_distances"), "distance", positive=True)
+            ok &= numbers is not None
+            if numbers is not None:
+                hints["push_distances"] = tuple(units.length_in(v) for v in numbers)
+        if node.has("push_directions"):
+            directions = self.push_directions(node.child("push_directions"))
+            ok &= directions is not None
+            hints["push_directions"] = directions
+        if node.has("max_nodes"):
+            child = node.child("max_nodes")
+            value = child.value
+            if _is_number(value) and isinstance(value, int) and value > 0:
+                hints["max_nodes"] = int(value)
+            else:
+                self.error(child, f"expected a positive whole number, got {_describe(value)}")
+                ok = False
+        return PlanningHints(**hints) if ok else None
+
+    def numbers(self, node: _Node, what: str, *, positive: bool) -> tuple[float, ...] | None:
+        items = self.list_of(node, f"a non-empty list of {what}s")
+        if items is None:
+            return None
+        article = "an" if what[0] in "aeiou" else "a"
+        values = [self.number(item, f"{article} {what}") for item in items]
+        if any(v is None for v in values):
+            return None
+        result = tuple(values)  # type: ignore[arg-type]
+        return self.positive(node, result, what) if positive else result
+
+    def push_directions(self, node: _Node) -> tuple[str, ...] | None:
+        items = self.list_of(node, f"a non-empty list drawn from {', '.join(PUSH_DIRECTIONS)}")
+        if items is None:
+            return None
+        chosen: list[str] = []
+        ok = True
+        for item in items:
+            if item.value not in PUSH_DIRECTIONS:
+                self.error(
+                    item,
+                    f"unknown push direction {_describe(item.value)}; expected one "
+                    f"of {', '.join(repr(d) for d in PUSH_DIRECTIONS)} (quoted)",
+                )
+                ok = False
+            elif item.value in chosen:
+                self.error(
+                    item, f"push direction {item.value!r} is listed twice; list each at most once"
+                )
+                ok = False
+            else:
+                chosen.append(str(item.value))
+        return tuple(chosen) if ok else None
+
+
+# ---------------------------------------------------------------------------------------------
+# geometry glue
+# ---------------------------------------------------------------------------------------------
+def _as_polygon(poly: Any) -> ConvexPolygon:
+    """A polygon as a tuple of ``(x, y)`` float tuples (what :class:`Shape` stores)."""
+    return tuple((float(x), float(y)) for x, y in poly)
+
+
+def _overlap_area(
+    parts_a: tuple[ConvexPolygon, ...],
+    pose_a: Pose,
+    parts_b: tuple[ConvexPolygon, ...],
+    pose_b: Pose,
+) -> float:
+    a = geometry.footprint(parts_a, pose_a)
+    b = geometry.footprint(parts_b, pose_b)
+    return float(a.intersection(b).area)
+
+
+def _char(character: Any) -> str:
+    """A character as ``U+0000`` (ruamel reports code points as ints)."""
+    if isinstance(character, int):
+        return f"U+{character:04X}"
+    if isinstance(character, str) and len(character) == 1:
+        return f"U+{ord(character):04X}"
+    return repr(character)

@@ -1,0 +1,917 @@
+"""Top-down rigid-body physics of place, push and pick (thesis §2.1.3, §2.4.1), on pymunk.
+
+This is the only module of arrange-up that imports pymunk. Its face is one function::
+
+    simulate(problem, state, action, noise=None, settings=DEFAULT_SETTINGS) -> StepOutcome
+
+plus :func:`rollout`, which draws the noise of each action of a sequence and simulates them in
+turn. Everything is in inches, seconds and radians; a body's mass is its areal density times its
+area (so a 1-inch block of density 0.125 has mass 0.125) and forces are in mass-inches per
+second squared.
+
+Actions
+=======
+* **Place** writes the placed pose (commanded pose + ``noise.pose_offset``) and simulates
+  nothing: the planner's precondition guarantees the placed object overlaps nothing.
+* **Pick** removes the object.
+* **Push** (thesis §2.4.1) builds a fresh space, writes the state, puts the manipulator down at
+  the approach pose (commanded + ``noise.pose_offset``), runs ``settle_steps`` steps, drives it
+  toward the reference point ``distance`` inches along its push direction until it stops moving,
+  stops driving it, waits until every other body is at rest, and lifts it off.
+
+Model
+=====
+* **Bodies.** A movable object in the state is a dynamic body of mass ``density * area`` and
+  moment ``sum(moment_for_poly(density * area_i, part_i))`` over its convex parts (the parts are
+  centred on the shape's centroid, which is the body origin). Parts use
+  ``noise.part_density``; a manipulator resting on the table uses ``noise.manipulator_density``.
+* **Fixtures** are clamped to the table while they are on it: kinematic bodies that nothing can
+  move. A fixture is a movable obstacle the robot places to push parts *against* (thesis ch. 4,
+  Figure 4-1); a fixture as light as a part would just be pushed along with it.
+  Mass and moment are set explicitly (shape density would leave rounding in the centre of
+  gravity and break bit-identical replay).
+* **Table friction** is pymunk's "tank" pattern: a ``PivotJoint`` and a ``GearJoint`` from each
+  movable body to the static body, both with ``max_bias = 0`` (they only resist motion); the
+  pivot's ``max_force`` is ``mu m g`` (Coulomb sliding friction) and the gear's is
+  ``mu g rho integral(|r| dA)`` (the torque of Coulomb friction on a body spinning about its
+  centroid, computed in closed form per convex part).
+* **Contact friction.** One coefficient ``mu = noise.friction`` holds for every pair of
+  surfaces: table, part-part, part-wall, part-paddle. pymunk multiplies the two shapes'
+  friction values, so every shape gets ``sqrt(mu)``. Elasticity is 0 (wood and acrylic blocks
+  do not bounce noticeably at a few inches per second).
+* **Walls** (``table.walls``) are ``wall_thickness``-inch static boxes just outside the table
+  edges, long enough to close the corners; edges without a wall are open, so a part can leave
+  the table there (reported as ``OFF_TABLE`` when its centroid ends outside the table).
+  Obstacles are static polygons at their poses.
+* **The manipulator** (paddle) has mass ``manipulator_density * area`` and infinite moment (the
+  robot holds it; it cannot turn) and **no table friction**: the robot carries it, so the drive
+  alone moves it.
+* **After the drive stops** the controller no longer pushes: its force toward the reference is
+  zero. The robot still holds the paddle, though, so it becomes a *brake* (the same joint with
+  ``max_bias = 0``: it resists being moved, up to the force clip, and pulls nowhere) until the
+  other bodies are at rest; then the paddle is removed. The thesis's literal alternative, a
+  paddle left free, was measured and rejected: released from a chain compressed against a wall,
+  the light frictionless paddle is kicked back by the contact solver's warm-started impulses,
+  so the blocks spring apart (gaps up to 0.025 in, chains moved up to 0.08 in, 15% more steps
+  on the benchmark chains), an artefact; with the brake, blocks end touching (overlaps within
+  the 0.005 in slop).
+
+The push controller
+===================
+The thesis drives the paddle with a clipped PD controller toward the reference point
+``ref = approach + distance * push_direction``::
+
+    F = clip(Kp (ref - x) - Kd v),   Kd = sqrt(4 m Kp)  (critically damped).
+
+Here it runs on pymunk's C side as one ``PivotJoint`` between the static body (anchor at
+``ref``) and the paddle (anchor at its centroid), with
+
+* ``max_force = push_force``: the force clip (pymunk clamps the impulse vector's length, so the
+  clip is on the force's magnitude rather than per axis);
+* ``max_bias = push_speed``: the speed limit;
+* ``error_bias = (1 - rate dt) ** (1 / dt)``, which makes the joint's target velocity exactly
+  ``rate * (ref - x)`` per step, with ``rate = 1 / (4 damping_ratio**2 dt)``.
+
+Each step the joint applies the impulse that brings the paddle's velocity to
+``clamp(rate (ref - x), push_speed)``, clamped to ``push_force * dt``. For the paddle alone that
+is, exactly (same floating-point recurrence, see ``tests/test_physics.py``), the semi-implicit
+Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))`` with
+
+    Kd = m / dt,   Kp = rate * Kd = m / (4 damping_ratio**2 dt**2),
+
+i.e. the thesis's clipped PD with ``Kd = sqrt(4 m Kp)`` when ``damping_ratio = 1`` (the
+default), written in the usual cascade form so that the speed limit caps the desired velocity.
+At dt = 1/240 and the paddle's m ~ 0.15 this is Kd ~ 36, Kp ~ 2,200 (omega = 1 / (2 dt) =
+120 rad/s): a stiff position servo, as a robot arm is. With these gains the velocity loop is
+dead-beat in discrete time and the position error then shrinks by ``1 - rate dt = 3/4`` per
+step: no overshoot, no oscillation.
+
+*Where it differs from a fixed-gain PD:* in contact, the joint is solved together with the
+contacts, so its derivative gain is the dead-beat one for everything the paddle is moving (the
+paddle plus the parts it pushes), not for the paddle alone. It therefore keeps the commanded
+speed while pushing and stalls only when the push needs more than ``push_force`` (or meets a
+wall), whereas a PD with the paddle's own gains would stall once ``Kp * error`` falls below the
+resistance. The thesis's observation that a push stops short when it collides holds in both.
+
+Defaults: ``push_speed = 3 in/s`` (a careful robot push; 1 to 5-inch pushes take 0.7 to 2.2 s
+of simulated time including the rest checks, and the paddle travels 0.0125 in per step, far
+below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
+above; a 1-inch block of density 0.125 weighs 48, so this pushes a chain of 7 blocks at the
+highest friction and density of the thesis's ranges, 223, with margin, and still stalls against
+a wall instead of crushing through it). Densities are in each problem's own units, so a problem
+of heavier parts raises the clip to 1.5 times the friction of all its parts at its nominal
+(mid-range) friction and density (:func:`push_force`): only the noisy TT mating, whose
+densities reach 1.0, is affected (1608); its heaviest draws still stall the push, as the
+thesis's low-gain controller stalled.
+
+Rest
+====
+Rest is judged from pose change, not velocity (bodies being separated move while reporting zero
+velocity): every ``rest_interval`` (0.1 s) of simulated time each body's pose is compared with
+the previous check; a body is still when it moved less than ``rest_linear_tol`` inches and
+``rest_angular_tol`` radians. The drive stops when the paddle was still ``rest_checks`` (2)
+checks in a row; the push ends when every other body was still ``rest_checks`` checks in a row,
+at least one of them after the drive stopped (the other bodies are watched from the first
+check at which the paddle is still, so the check that stops the drive can count: that saves
+one interval per push and still ends every push with two consecutive still checks of every
+body). The whole push is capped at ``max_time`` (20 s) of simulated time; a cap hit is reported
+as ``NOT_AT_REST`` with the poses at the cap, never silently truncated.
+
+Overlaps beyond the slop are pushed apart at 20% per step (``collision_bias``, Box2D's
+Baumgarte factor) rather than pymunk's default 2.6%: a chain that hits a wall at 3 in/s is
+squeezed by the solver, and at the default rate its slow re-expansion against the paddle kept
+the paddle creeping for most of a second (a 7-block chain took 458 steps instead of 266, with
+final poses within 0.004 in of each other).
+
+Accuracy: on the benchmark scenes (:mod:`arrange_up.physics.bench`, 30 noisy pushes each) final
+positions at the defaults were within 0.01-0.02 in (median) and 0.033 in (max) of a run at
+dt 1/960 with 30 iterations.
+
+Determinism and speed
+=====================
+A fresh space is built per push, in a fixed order (walls, obstacles, movable bodies in state
+order, the manipulator), with explicit masses, so the same inputs give bit-identical results in
+any process (a reused space does not; see ``shared/notes/physics.md``).
+
+Speed is first-class: pushes are simulated millions of times by the planners. The space is
+built and stepped through pymunk's cffi binding (``pymunk._chipmunk_cffi.lib``, the C functions
+the pymunk classes wrap) rather than through the Python classes, whose per-object bookkeeping
+cost more than the simulation itself for small scenes (building a 1-block scene takes ~30 us
+this way against ~300 us through the classes); the controller runs entirely in C, so a step is
+one C call (~0.5 us of it is the call and the step's fixed cost); Python looks at the bodies
+only every ``rest_interval``. Everything built is freed explicitly (``try``/``finally``).
+``pymunk._chipmunk_cffi`` is not public API (``pymunk.batch`` uses it too); pyproject pins
+pymunk ~= 7.3 and the tests exercise every call made here.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+# pymunk's cffi binding: the Chipmunk2D C API that pymunk's classes wrap (pymunk ~= 7.3).
+from pymunk._chipmunk_cffi import ffi, lib
+
+from arrange_up.model.problem import ArrangementProblem, ObjectKind, Pose, Table
+from arrange_up.model.world import (
+    Action,
+    ActionNoise,
+    Pick,
+    Place,
+    Push,
+    WorldState,
+    draw_noise,
+    nominal_noise,
+)
+
+__all__ = [
+    "DEFAULT_SETTINGS",
+    "PhysicsSettings",
+    "StepOutcome",
+    "StepStatus",
+    "pd_gains",
+    "rollout",
+    "simulate",
+]
+
+
+# ----------------------------------------------------------------------------------------------
+# Settings and outcome
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PhysicsSettings:
+    """Numerical and controller settings of the simulation (inches, seconds, radians).
+
+    Every default is measured or argued in ``shared/notes/physics.md`` or in this module's
+    docstring.
+    """
+
+    dt: float = 1.0 / 240.0
+    """Time step. 1/60 is too coarse for chains of blocks (0.3 in errors, buckling, 6% never
+    settle); 1/240 gave 0.02-0.06 in against a 1/960 reference and always settled."""
+    iterations: int = 10
+    """Solver iterations per step; 5-10 were accurate at dt 1/240, 10 is the safe end."""
+    collision_slop: float = 0.005
+    """Allowed resting overlap (in). pymunk's default 0.1 is sized for pixels."""
+    collision_bias: float = 0.8**240
+    """Fraction of an overlap beyond the slop left uncorrected after one second: ``0.8 ** 240``
+    corrects 20% per step at dt 1/240 (Box2D's Baumgarte factor; pymunk's default ``0.9 ** 60``
+    is 2.6% per step and lets squeezed chains creep for a second, see the module docstring)."""
+    gravity: float = 386.09
+    """Standard gravity in in/s^2; only the table friction uses it (the world is top-down)."""
+    rest_interval: float = 0.1
+    """Simulated time between rest checks (s); rounded to whole steps (24 at dt 1/240)."""
+    rest_linear_tol: float = 1e-3
+    """A body is still when it moved less than this (in) since the previous check..."""
+    rest_angular_tol: float = 1e-3
+    """...and turned less than this (rad)."""
+    rest_checks: int = 2
+    """Consecutive still checks that make rest (one can be a momentary stop)."""
+    max_time: float = 20.0
+    """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
+    settle_steps: int = 2
+    """Steps run after writing the state, before driving the manipulator: the thesis ran "a
+    couple of time steps" so the engine builds its contact state first. The overlap check reads
+    the contacts they build (0 turns the check off)."""
+    push_speed: float = 3.0
+    """Speed limit of the manipulator (in/s): a careful robot push, 0.0125 in per step."""
+    push_force: float = 400.0
+    """Force clip of the controller (mass-in/s^2, mass = density x in^2): pushes a 7-block
+    chain at the worst friction and density of the thesis's ranges (223) with margin. A
+    problem whose parts are heavier raises it (see :func:`push_force`)."""
+    load_margin: float = 1.5
+    """The clip is at least this many times the friction of all the problem's parts at the
+    middle of its friction and part-density ranges (:func:`push_force`)."""
+    damping_ratio: float = 1.0
+    """Damping ratio of the PD; 1 is the thesis's critically damped Kd = sqrt(4 m Kp)."""
+    wall_thickness: float = 1.0
+    """Thickness of the static wall boxes (in); far more than one step's travel."""
+    overlap_tolerance: float = 0.02
+    """Deepest overlap between shapes (in) accepted when the push starts; deeper gives
+    ``OVERLAP`` (overlapping bodies drift apart for seconds and the result means little)."""
+
+    def __post_init__(self) -> None:
+        positive = (
+            "dt",
+            "gravity",
+            "rest_interval",
+            "max_time",
+            "push_speed",
+            "push_force",
+            "load_margin",
+            "damping_ratio",
+            "wall_thickness",
+            "collision_slop",
+        )
+        for name in positive:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(
+                    f"PhysicsSettings.{name} must be positive and finite, got {value!r}"
+                )
+        for name in ("rest_linear_tol", "rest_angular_tol", "overlap_tolerance"):
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"PhysicsSettings.{name} must be non-negative")
+        for name in ("iterations", "rest_checks"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"PhysicsSettings.{name} must be at least 1")
+        if not 0.0 <= self.collision_bias <= 1.0:
+            raise ValueError("PhysicsSettings.collision_bias must be in [0, 1]")
+        if self.settle_steps < 0:
+            raise ValueError("PhysicsSettings.settle_steps must be non-negative")
+        if self.approach_rate * self.dt > 1.0:
+            raise ValueError(
+                "PhysicsSettings.damping_ratio must be at least 0.5 (a smaller "
+                "one makes the discrete controller overshoot)"
+            )
+
+    @property
+    def approach_rate(self) -> float:
+        """Rate (1/s) of the position loop, ``Kp / Kd = 1 / (4 damping_ratio^2 dt)``."""
+        return 1.0 / (4.0 * self.damping_ratio * self.damping_ratio * self.dt)
+
+    @property
+    def interval_steps(self) -> int:
+        """Steps between rest checks."""
+        return max(1, round(self.rest_interval / self.dt))
+
+    @property
+    def max_steps(self) -> int:
+        """Steps in ``max_time`` (the cap)."""
+        return max(1, math.ceil(self.max_time / self.dt - 1e-9))
+
+
+DEFAULT_SETTINGS = PhysicsSettings()
+
+
+def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS) -> float:
+    """The controller's force clip for ``problem``: ``settings.push_force``, raised to
+    ``load_margin`` times the table friction of every part of the problem at the middle of its
+    friction and part-density ranges when that is more.
+
+    Densities are in the problem's own mass units, so a fixed clip cannot suit every problem:
+    the thesis's noisy TT mating draws densities up to 1.0, eight times the blocks', and a clip
+    sized for blocks could not move its parts at all under nominal parameters. Scaled this way
+    the robot always pushes everything the problem has at once under nominal parameters, with
+    margin, while the heaviest, most frictional draws of a very noisy problem may still stall
+    it, as the thesis's low-gain controller stalled ("doesn't apply enough force to move the
+    desired distance when there are collisions", §2.1.3). Every shipped problem but the noisy
+    TT mating keeps the default (the largest nominal load, TT mating's, needs 398).
+    """
+    return _force_clip(problem, sum(spec.shape.area for spec in problem.parts), settings)
+
+
+def _force_clip(problem: ArrangementProblem, parts_area: float, settings: PhysicsSettings) -> float:
+    u = problem.uncertainty
+    friction = 0.5 * (u.friction[0] + u.friction[1])
+    density = 0.5 * (u.part_density[0] + u.part_density[1])
+    # Keep this product's order: simulations are chaotic to the last bit, and reassociating it
+    # changed four of tt-mating-noisy's five nominal plans (and staled their measurements).
+    return max(
+        settings.push_force,
+        settings.load_margin * settings.gravity * friction * density * parts_area,
+    )
+
+
+def pd_gains(mass: float, settings: PhysicsSettings = DEFAULT_SETTINGS) -> tuple[float, float]:
+    """``(Kp, Kd)`` of the PD the push controller is, for a paddle of ``mass`` (free motion).
+
+    ``Kd = m / dt`` (dead-beat velocity loop) and ``Kp = approach_rate * Kd``; with the default
+    ``damping_ratio = 1`` that is ``Kd = sqrt(4 m Kp)``.
+    """
+    kd = mass / settings.dt
+    return settings.approach_rate * kd, kd
+
+
+class StepStatus(enum.StrEnum):
+    """How an action's simulation ended. Anything but ``OK`` makes the outcome unreliable."""
+
+    OK = "ok"
+    """Every body came to rest on the table."""
+    NOT_AT_REST = "not_at_rest"
+    """The ``max_time`` cap was hit before everything came to rest (poses are those at the
+    cap)."""
+    OFF_TABLE = "off_table"
+    """Everything came to rest, but the centroid of at least one object (listed in
+    ``off_table``) is outside the table rectangle: it would have fallen off."""
+    OVERLAP = "overlap"
+    """When the push started, shapes overlapped by more than ``overlap_tolerance`` (an invalid
+    state or approach pose); the simulation was still run, but means little."""
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """The result of simulating one action.
+
+    ``state`` holds the poses after the action (for a pick the object is removed, for a place
+    the placed pose is the commanded pose plus the noise offset, for a push the poses at rest,
+    or at the cap). Angles are continuous: a body's theta is its initial theta plus the
+    rotation it made (not wrapped). ``status`` takes the first that applies of ``OVERLAP``,
+    ``NOT_AT_REST``, ``OFF_TABLE``, ``OK``. ``sim_time`` and ``steps`` count the simulated time
+    and physics steps (0 for place and pick); ``manipulator_travel`` is how far the paddle moved
+    along its push direction while it was driven (in); ``overlap`` the deepest overlap between
+    shapes when the push started (in, 0 when none).
+    """
+
+    state: WorldState
+    status: StepStatus = StepStatus.OK
+    off_table: tuple[str, ...] = ()
+    sim_time: float = 0.0
+    steps: int = 0
+    manipulator_travel: float = 0.0
+    overlap: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.status is StepStatus.OK
+
+
+# ----------------------------------------------------------------------------------------------
+# Geometry compiled once per problem
+# ----------------------------------------------------------------------------------------------
+
+
+def _abs_r_integral(poly: Sequence[tuple[float, float]]) -> float:
+    """``integral(|r| dA)`` over a convex CCW polygon, ``r`` measured from the origin.
+
+    Sum over edges of the signed integral over the triangle (origin, a, b): with ``p`` the
+    distance from the origin to the edge's line and ``t`` the coordinate along it,
+    ``integral = [p t |r| + p^3 asinh(t / p)] / 6`` between the edge's ends (polar coordinates,
+    ``integral sec^3``). Exact for the origin inside or outside the polygon.
+    """
+    total = 0.0
+    n = len(poly)
+    for i in range(n):
+        ax, ay = poly[i]
+        bx, by = poly[(i + 1) % n]
+        cross = ax * by - ay * bx
+        ex, ey = bx - ax, by - ay
+        length = math.hypot(ex, ey)
+        if length == 0.0 or cross == 0.0:
+            continue
+        p = abs(cross) / length
+        ex, ey = ex / length, ey / length
+        ta, tb = ax * ex + ay * ey, bx * ex + by * ey
+        value = (
+            p * (tb * math.hypot(bx, by) - ta * math.hypot(ax, ay))
+            + p**3 * (math.asinh(tb / p) - math.asinh(ta / p))
+        ) / 6.0
+        total += math.copysign(value, cross)
+    return total
+
+
+def _poly_area(poly: Sequence[tuple[float, float]]) -> float:
+    n = len(poly)
+    return 0.5 * sum(
+        poly[i][0] * poly[(i + 1) % n][1] - poly[(i + 1) % n][0] * poly[i][1] for i in range(n)
+    )
+
+
+@dataclass(frozen=True)
+class _Body:
+    """An object's shape, ready to build: cffi vertex arrays and per-unit-density integrals."""
+
+    kind: ObjectKind
+    parts: tuple[tuple[int, object], ...]  # (vertex count, cpVect[] array) per convex part
+    area: float
+    part_moments: tuple[tuple[float, float], ...]  # (area_i, moment of part i per unit mass)
+    abs_r: float  # integral(|r| dA) over the shape
+    push_direction: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class _Compiled:
+    problem: ArrangementProblem
+    bodies: dict[str, _Body]
+    statics: tuple[tuple[int, object], ...]  # wall and obstacle polygons in world coordinates
+    table: Table
+    wall_thickness: float
+    parts_area: float  # of all the problem's parts, for the force clip (push_force)
+
+
+_IDENTITY = ffi.new("cpTransform *", (1.0, 0.0, 0.0, 1.0, 0.0, 0.0))[0]
+_CACHE: dict[int, _Compiled] = {}
+_CACHE_SIZE = 16
+
+
+def _wall_boxes(table: Table, thickness: float) -> list[tuple[tuple[float, float], ...]]:
+    w, d, t = table.width, table.depth, thickness
+    boxes = {
+        "left": (-t, -t, 0.0, d + t),
+        "right": (w, -t, w + t, d + t),
+        "bottom": (-t, -t, w + t, 0.0),
+        "top": (-t, d, w + t, d + t),
+    }
+    out = []
+    for edge in ("left", "right", "bottom", "top"):  # fixed order, whatever the file's order
+        if edge in table.walls:
+            x0, y0, x1, y1 = boxes[edge]
+            out.append(((x0, y0), (x1, y0), (x1, y1), (x0, y1)))
+    return out
+
+
+def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
+    key = id(problem)
+    hit = _CACHE.get(key)
+    if hit is not None and hit.problem is problem and hit.wall_thickness == wall_thickness:
+        return hit
+    bodies: dict[str, _Body] = {}
+    statics: list[tuple[int, object]] = []
+    for poly in _wall_boxes(problem.table, wall_thickness):
+        statics.append((len(poly), ffi.new("cpVect[]", poly)))
+    for spec in problem.objects:
+        parts = spec.shape.parts
+        if spec.kind is ObjectKind.OBSTACLE:
+            if spec.pose is None:
+                raise ValueError(f"obstacle {spec.name!r} has no pose")
+            x, y, th = spec.pose
+            c, s = math.cos(th), math.sin(th)
+            for part in parts:
+                world = [(x + c * px - s * py, y + s * px + c * py) for px, py in part]
+                statics.append((len(world), ffi.new("cpVect[]", world)))
+            continue
+        areas = [_poly_area(part) for part in parts]
+        moments = [
+            lib.cpMomentForPoly(1.0, len(part), list(part), (0.0, 0.0), 0.0) for part in parts
+        ]
+        bodies[spec.name] = _Body(
+            kind=spec.kind,
+            parts=tuple((len(part), ffi.new("cpVect[]", list(part))) for part in parts),
+            area=sum(areas),
+            part_moments=tuple(zip(areas, moments, strict=True)),
+            abs_r=sum(_abs_r_integral(part) for part in parts),
+            push_direction=spec.push_direction,
+        )
+    parts_area = sum(spec.shape.area for spec in problem.parts)  # as push_force sums it
+    compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness, parts_area)
+    if len(_CACHE) >= _CACHE_SIZE:
+        _CACHE.pop(next(iter(_CACHE)))
+    _CACHE[key] = compiled
+    return compiled
+
+
+# ----------------------------------------------------------------------------------------------
+# Simulation
+# ----------------------------------------------------------------------------------------------
+
+
+def simulate(
+    problem: ArrangementProblem,
+    state: WorldState,
+    action: Action,
+    noise: ActionNoise | None = None,
+    settings: PhysicsSettings = DEFAULT_SETTINGS,
+) -> StepOutcome:
+    """Simulate one action from ``state`` (see the module docstring for the model).
+
+    ``noise`` defaults to the noise-free draw (:func:`arrange_up.model.world.nominal_noise`).
+    Raises :class:`ValueError` for an invalid call: unknown names, a state listing an obstacle
+    or an object twice, placing an object already on the table (or one that is not a part or a
+    fixture), picking one that is not on the table, pushing with an object that is not a
+    manipulator or that is on the table, a negative or non-finite push distance.
+    """
+    compiled = _compile(problem, settings.wall_thickness)
+    _check_state(compiled, state)
+    if noise is None:
+        noise = nominal_noise(problem)
+    if isinstance(action, Push):
+        return _push(compiled, state, action, noise, settings)
+    if isinstance(action, Place):
+        return _place(compiled, state, action, noise)
+    if isinstance(action, Pick):
+        return _pick(compiled, state, action)
+    raise ValueError(f"unknown action {action!r}: expected Place, Push or Pick")
+
+
+def rollout(
+    problem: ArrangementProblem,
+    state: WorldState,
+    actions: Sequence[Action],
+    rng: np.random.Generator,
+    settings: PhysicsSettings = DEFAULT_SETTINGS,
+) -> list[StepOutcome]:
+    """Simulate ``actions`` in turn from ``state``, drawing each one's noise from ``rng``.
+
+    Noise is drawn with :func:`arrange_up.model.world.draw_noise` (always the same amount of
+    randomness per action). Stops after the first outcome that is not ``OK``, which is the last
+    one returned.
+    """
+    outcomes: list[StepOutcome] = []
+    for action in actions:
+        outcome = simulate(problem, state, action, draw_noise(problem, action, rng), settings)
+        outcomes.append(outcome)
+        if not outcome.ok:
+            break
+        state = outcome.state
+    return outcomes
+
+
+def _check_state(compiled: _Compiled, state: WorldState) -> None:
+    bodies = compiled.bodies
+    names = [name for name, _ in state.poses]
+    for name in names:
+        if name not in bodies:
+            if any(spec.name == name for spec in compiled.problem.objects):
+                raise ValueError(f"obstacle {name!r} cannot be in a world state (it never moves)")
+            raise ValueError(f"unknown object {name!r} in the world state")
+    if len(set(names)) != len(names):
+        raise ValueError(f"world state lists an object twice: {names}")
+
+
+def _spec_kind(compiled: _Compiled, name: str, role: str) -> ObjectKind:
+    body = compiled.bodies.get(name)
+    if body is not None:
+        return body.kind
+    if any(spec.name == name for spec in compiled.problem.objects):
+        return ObjectKind.OBSTACLE
+    raise ValueError(f"{role}: unknown object {name!r} in problem {compiled.problem.name!r}")
+
+
+def _off_table(table: Table, poses: Sequence[tuple[str, Pose]]) -> tuple[str, ...]:
+    w, d = table.width, table.depth
+    return tuple(name for name, (x, y, _) in poses if not (0.0 <= x <= w and 0.0 <= y <= d))
+
+
+def _finish(
+    compiled: _Compiled, poses: tuple[tuple[str, Pose], ...], status: StepStatus, **kw
+) -> StepOutcome:
+    off = _off_table(compiled.table, poses)
+    if status is StepStatus.OK and off:
+        status = StepStatus.OFF_TABLE
+    return StepOutcome(WorldState(poses), status, off, **kw)
+
+
+def _place(
+    compiled: _Compiled, state: WorldState, action: Place, noise: ActionNoise
+) -> StepOutcome:
+    kind = _spec_kind(compiled, action.obj, "place")
+    if kind not in (ObjectKind.PART, ObjectKind.FIXTURE):
+        raise ValueError(
+            f"place: {action.obj!r} is a {kind.value}; only parts and fixtures are "
+            "placed (a manipulator is put down by a push)"
+        )
+    if action.obj in state:
+        raise ValueError(f"place: {action.obj!r} is already on the table")
+    dx, dy, dth = noise.pose_offset
+    x, y, th = action.pose
+    placed = (float(x) + dx, float(y) + dy, float(th) + dth)
+    mapping = state.as_dict()
+    mapping[action.obj] = placed
+    order = [spec.name for spec in compiled.problem.objects if spec.name in mapping]
+    poses = tuple((name, mapping[name]) for name in order)
+    return _finish(compiled, poses, StepStatus.OK)
+
+
+def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
+    if _spec_kind(compiled, action.obj, "pick") is ObjectKind.OBSTACLE:
+        raise ValueError(f"pick: {action.obj!r} is an obstacle (obstacles never move)")
+    if action.obj not in state:
+        raise ValueError(f"pick: {action.obj!r} is not on the table")
+    poses = tuple((name, pose) for name, pose in state.poses if name != action.obj)
+    return _finish(compiled, poses, StepStatus.OK)
+
+
+def _add_drive(
+    space, static, paddle, ref: tuple[float, float], settings: PhysicsSettings, force: float
+):
+    """The clipped PD of the push as a pivot joint, clipped at ``force`` (module docstring)."""
+    joint = lib.cpPivotJointNew2(static, paddle, ref, (0.0, 0.0))
+    lib.cpConstraintSetMaxForce(joint, force)
+    lib.cpConstraintSetMaxBias(joint, settings.push_speed)
+    lib.cpConstraintSetErrorBias(
+        joint, (1.0 - settings.approach_rate * settings.dt) ** (1.0 / settings.dt)
+    )
+    lib.cpSpaceAddConstraint(space, joint)
+    return joint
+
+
+def _push(
+    compiled: _Compiled,
+    state: WorldState,
+    action: Push,
+    noise: ActionNoise,
+    s: PhysicsSettings,
+) -> StepOutcome:
+    name = action.manipulator
+    kind = _spec_kind(compiled, name, "push")
+    if kind is not ObjectKind.MANIPULATOR:
+        raise ValueError(f"push: {name!r} is a {kind.value}, not a manipulator")
+    if name in state:
+        raise ValueError(f"push: manipulator {name!r} is already on the table")
+    distance = float(action.distance)
+    if not (math.isfinite(distance) and distance >= 0.0):
+        raise ValueError(f"push: distance must be finite and non-negative, got {distance!r}")
+
+    if not all(math.isfinite(v) for v in action.pose):
+        raise ValueError(f"push: approach pose must be finite, got {action.pose!r}")
+    _check_noise(noise)
+    mu = float(noise.friction)
+    g = s.gravity
+    shape_mu = math.sqrt(mu)
+    dt = s.dt
+    step = lib.cpSpaceStep
+    get_pos = lib.cpBodyGetPosition
+    get_angle = lib.cpBodyGetAngle
+    add_shape = lib.cpSpaceAddShape
+    add_constraint = lib.cpSpaceAddConstraint
+    set_friction = lib.cpShapeSetFriction
+    set_max_force = lib.cpConstraintSetMaxForce
+    set_max_bias = lib.cpConstraintSetMaxBias
+    new_poly = lib.cpPolyShapeNew
+    identity = _IDENTITY
+
+    space = lib.cpSpaceNew()
+    shapes: list = []
+    constraints: list = []
+    bodies: list = []
+    try:
+        lib.cpSpaceSetIterations(space, s.iterations)
+        lib.cpSpaceSetCollisionSlop(space, s.collision_slop)
+        lib.cpSpaceSetCollisionBias(space, s.collision_bias)
+        static = lib.cpSpaceGetStaticBody(space)
+
+        def add_body(body, body_def, x: float, y: float, th: float) -> None:
+            """Put ``body`` at its pose in the space with its convex shapes (kept alive)."""
+            bodies.append(body)
+            lib.cpBodySetPosition(body, (x, y))
+            lib.cpBodySetAngle(body, th)
+            lib.cpSpaceAddBody(space, body)
+            for count, verts in body_def.parts:
+                shape = new_poly(body, count, verts, identity, 0.0)
+                shapes.append(shape)
+                set_friction(shape, shape_mu)
+                add_shape(space, shape)
+
+        # 1. walls and obstacles
+        for count, verts in compiled.statics:
+            shape = new_poly(static, count, verts, identity, 0.0)
+            shapes.append(shape)
+            set_friction(shape, shape_mu)
+            add_shape(space, shape)
+
+        # 2. movable bodies, in state order, with table friction
+        for obj, (x, y, th) in state.poses:
+            body_def = compiled.bodies[obj]
+            clamped = body_def.kind is ObjectKind.FIXTURE
+            rho = (
+                noise.manipulator_density
+                if body_def.kind is ObjectKind.MANIPULATOR
+                else noise.part_density
+            )
+            mass = rho * body_def.area
+            if clamped:
+                # Clamped to the table (see the module docstring): a kinematic body that
+                # never moves, with no table friction to model.
+                body = lib.cpBodyNewKinematic()
+            else:
+                moment = 0.0
+                for area_i, unit_moment in body_def.part_moments:
+                    moment += rho * area_i * unit_moment
+                body = lib.cpBodyNew(mass, moment)
+            add_body(body, body_def, x, y, th)
+            if clamped:
+                continue
+            pivot = lib.cpPivotJointNew2(static, body, (0.0, 0.0), (0.0, 0.0))
+            constraints.append(pivot)
+            set_max_bias(pivot, 0.0)
+            set_max_force(pivot, mu * mass * g)
+            add_constraint(space, pivot)
+            gear = lib.cpGearJointNew(static, body, 0.0, 1.0)
+            constraints.append(gear)
+            set_max_bias(gear, 0.0)
+            set_max_force(gear, mu * g * rho * body_def.abs_r)
+            add_constraint(space, gear)
+        n_movable = len(bodies)
+
+        # 3. the manipulator at the (noisy) approach pose: infinite moment, no table friction
+        paddle_def = compiled.bodies[name]
+        ox, oy, oth = noise.pose_offset
+        px, py, pth = action.pose
+        px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
+        paddle = lib.cpBodyNew(noise.manipulator_density * paddle_def.area, math.inf)
+        add_body(paddle, paddle_def, px, py, pth)
+        ux, uy = paddle_def.push_direction
+        c, sn = math.cos(pth), math.sin(pth)
+        dx, dy = ux * c - uy * sn, ux * sn + uy * c
+
+        # 4. settle, then look for overlaps in the contacts the engine built
+        for _ in range(s.settle_steps):
+            step(space, dt)
+        steps = s.settle_steps
+        overlap = _deepest_overlap(space) if s.settle_steps else 0.0
+
+        # 5. drive until the paddle is still, then stop driving and wait until every other
+        # body is at rest. Stopping turns the drive into a brake (no bias: no force toward the
+        # reference, it only holds the paddle where it is). Rest checks every `interval`
+        # steps; the other bodies are watched from the first check the paddle is still, so
+        # their rest can count the check at which the drive stops (always followed by at
+        # least one check with the brake on).
+        drive = _add_drive(
+            space,
+            static,
+            paddle,
+            (px + distance * dx, py + distance * dy),
+            s,
+            _force_clip(compiled.problem, compiled.parts_area, s),
+        )
+        constraints.append(drive)
+        interval = s.interval_steps
+        max_steps = s.max_steps
+        lin2 = s.rest_linear_tol * s.rest_linear_tol
+        ang_tol = s.rest_angular_tol
+        need = s.rest_checks
+        movable = bodies[:n_movable]
+        capped = False
+        driving = True
+        paddle_still = 0
+        others_still = 0
+        last = None
+        last_x, last_y = px, py
+        travel = 0.0
+        while True:
+            if steps + interval > max_steps:
+                for _ in range(max_steps - steps):
+                    step(space, dt)
+                steps = max(steps, max_steps)
+                capped = True
+                if driving:
+                    pos = get_pos(paddle)
+                    last_x, last_y = pos.x, pos.y
+                break
+            for _ in range(interval):
+                step(space, dt)
+            steps += interval
+            if driving:
+                pos = get_pos(paddle)
+                ex, ey = pos.x - last_x, pos.y - last_y
+                last_x, last_y = pos.x, pos.y
+                if ex * ex + ey * ey < lin2:
+                    paddle_still += 1
+                else:
+                    paddle_still = 0
+                    last = None
+                    others_still = 0
+                    continue
+            now = []
+            for b in movable:
+                pos = get_pos(b)
+                now.append((pos.x, pos.y, get_angle(b)))
+            if last is not None:
+                for (x0, y0, a0), (x1, y1, a1) in zip(last, now, strict=True):
+                    if (x1 - x0) ** 2 + (y1 - y0) ** 2 >= lin2 or abs(a1 - a0) >= ang_tol:
+                        others_still = 0
+                        break
+                else:
+                    others_still += 1
+            last = now
+            if driving:
+                if paddle_still >= need:
+                    driving = False
+                    set_max_bias(drive, 0.0)
+                    travel = (last_x - px) * dx + (last_y - py) * dy
+            elif others_still >= need:
+                break
+        if driving:  # capped while driving
+            travel = (last_x - px) * dx + (last_y - py) * dy
+        poses = []
+        for (obj, _), b in zip(state.poses, movable, strict=True):
+            pos = get_pos(b)
+            poses.append((obj, (pos.x, pos.y, get_angle(b))))
+    finally:
+        lib.cpSpaceFree(space)
+        for shape in shapes:
+            lib.cpShapeFree(shape)
+        for constraint in constraints:
+            lib.cpConstraintFree(constraint)
+        for body in bodies:
+            lib.cpBodyFree(body)
+
+    if overlap > s.overlap_tolerance:
+        status = StepStatus.OVERLAP
+    elif capped:
+        status = StepStatus.NOT_AT_REST
+    else:
+        status = StepStatus.OK
+    return _finish(
+        compiled,
+        tuple(poses),
+        status,
+        sim_time=steps * dt,
+        steps=steps,
+        manipulator_travel=travel,
+        overlap=overlap,
+    )
+
+
+def _check_noise(noise: ActionNoise) -> None:
+    if not (math.isfinite(noise.friction) and noise.friction >= 0.0):
+        raise ValueError(f"friction must be finite and non-negative, got {noise.friction!r}")
+    for name in ("part_density", "manipulator_density"):
+        value = getattr(noise, name)
+        if not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"{name} must be positive and finite, got {value!r}")
+
+
+def _deepest_overlap(space) -> float:
+    """Deepest penetration (in, >= 0) among the contacts of the last step."""
+    floats = lib.pmFloatArrayNew(0)
+    ints = lib.pmIntArrayNew(0)
+    try:
+        data = ffi.new("pmBatchedData *")
+        data.fields = lib.DISTANCE_1 | lib.DISTANCE_2 | lib.CONTACT_COUNT
+        data.floatArray = floats
+        data.intArray = ints
+        lib.cpSpaceEachCachedArbiter(
+            space, ffi.addressof(lib, "pmSpaceArbiterIteratorFuncBatched"), data
+        )
+        n = floats.num
+        if n == 0:
+            return 0.0
+        deepest = min(floats.arr[i] for i in range(n))
+        return max(0.0, -float(deepest))
+    finally:
+        lib.pmFloatArrayFree(floats)
+        lib.pmIntArrayFree(ints)
+
+
+def _drive_trajectory(
+    mass: float,
+    start: tuple[float, float],
+    ref: tuple[float, float],
+    n_steps: int,
+    settings: PhysicsSettings = DEFAULT_SETTINGS,
+) -> list[tuple[float, float, float, float]]:
+    """``(x, y, vx, vy)`` after each step of a lone paddle driven toward ``ref``.
+
+    The paddle (``mass``, infinite moment, no shape) is driven by exactly the joint
+    :func:`simulate` uses (:func:`_add_drive`); the tests compare this with the clipped PD it
+    implements.
+    """
+    space = lib.cpSpaceNew()
+    paddle = lib.cpBodyNew(mass, math.inf)
+    drive = None
+    try:
+        lib.cpSpaceSetIterations(space, settings.iterations)
+        lib.cpBodySetPosition(paddle, start)
+        lib.cpSpaceAddBody(space, paddle)
+        drive = _add_drive(
+            space, lib.cpSpaceGetStaticBody(space), paddle, ref, settings, settings.push_force
+        )
+        out = []
+        for _ in range(n_steps):
+            lib.cpSpaceStep(space, settings.dt)
+            p = lib.cpBodyGetPosition(paddle)
+            v = lib.cpBodyGetVelocity(paddle)
+            out.append((p.x, p.y, v.x, v.y))
+        return out
+    finally:
+        lib.cpSpaceFree(space)
+        if drive is not None:
+            lib.cpConstraintFree(drive)
+        lib.cpBodyFree(paddle)

@@ -1,0 +1,400 @@
+"""Action generators and preconditions (thesis §2.1.3, §2.2.1).
+
+The action space is continuous; these generators propose a small discrete set per belief.
+
+**Place** (Figure 2-10): for every goal part off the table, candidates at the part's goal
+target plus offsets from a 3 x 3 grid (``planning.place_offsets`` replaces the grid). The
+default step is the growth of the part's place shadow over its nominal footprint plus 0.1 in:
+just enough for the place precondition to hold next to walls and neighbours, and no more,
+since every extra inch must be pushed and pushing accrues uncertainty. The angle is the
+target's (``planning.place_angles`` adds alternatives). For a relative goal the target is the
+goal pose composed with the reference part's current belief centre.
+
+**Push** (Figure 2-11): "object-centric" pushes. For every part on the table and every axis
+direction (``planning.push_directions`` restricts them), the manipulator is put behind the
+part's belief shadow, turned so that it pushes along the direction, centred on the part's
+belief centre across the direction — shifted along its long side just enough to stay clear of
+walls and of the shadows beside it, as long as it still covers the part's centre.
+
+With ``unclipped_pushes`` (the planner sets it for semantics that refuse uncertain contacts,
+i.e. CBST), when that position *clips* a shadow ahead (its long side overlaps the shadow's side
+without covering it whole, so whether it touches that part is uncertain), the same push is
+offered a second time from the nearest position that misses or wholly covers every shadow
+ahead. The first position keeps plans that move a neighbouring row along (CBST's blocks-7 plan
+needs it); the second makes contacts certain where CBST must refuse a clipped one (without it, a
+plain row of four blocks against a wall had no CBST plan: each new block's push down clipped
+the block beside it). Particle semantics simulate clipped contacts, and for them the extra
+pushes only widen the search (25-particle blocks-7 then ran out of nodes in 2 of 3 seeds), so
+it is off by default.
+Distances:
+
+* to the wall ahead (the controller stalls when the train of parts is compressed against it),
+  generated only when the goal holds the part against that wall, directly or through a train
+  of touching goal parts that are all on the table already — never towards an edge without a
+  wall, where it would only push parts off;
+* to the part's goal coordinate along the direction, when that lies ahead;
+* each of ``planning.push_distances`` (how far the part should travel).
+
+A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
+such a push cannot help it, and it multiplies the search's plateaus.
+
+**Pick**: fixtures and manipulators on the table may be picked up; parts are never picked by
+the planner (a part must end on the table).
+
+Preconditions are tested on belief shadows (:mod:`arrange_up.geometry.collision`): a placed object's
+shadow (target ± place uncertainty) and a manipulator's approach shadow (approach pose ± push
+uncertainty) must not touch any shadow of an object on the table, a wall or an obstacle, and a
+placed object's shadow must lie on the table.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from arrange_up.belief.states import IntervalBelief, wrap_angle
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.problem import ArrangementProblem, ObjectKind, ObjectSpec, Pose
+from arrange_up.model.world import Action, Pick, Place, Push
+
+#: Direction name -> unit vector in the world frame.
+DIRECTIONS: dict[str, tuple[float, float]] = {
+    "+x": (1.0, 0.0),
+    "-x": (-1.0, 0.0),
+    "+y": (0.0, 1.0),
+    "-y": (0.0, -1.0),
+}
+#: Gap kept between the manipulator's approach shadow and the part's shadow (inches).
+APPROACH_GAP = 0.02
+#: Minimum useful push (inches): shorter candidates are dropped.
+MIN_PUSH = 0.05
+#: Candidate distances closer than this are considered the same (inches).
+DISTANCE_RESOLUTION = 0.01
+
+
+@dataclass(frozen=True)
+class _Manipulator:
+    spec: ObjectSpec
+    length: float  # along the long side
+    thickness: float  # along the push direction
+    push_angle: float  # angle of the push direction in the manipulator's frame
+
+
+class ActionGenerator:
+    """Proposes the candidate actions of a belief (see the module docstring)."""
+
+    def __init__(
+        self,
+        problem: ArrangementProblem,
+        checker: CollisionChecker,
+        *,
+        unclipped_pushes: bool = False,
+    ) -> None:
+        self.problem = problem
+        self.checker = checker
+        self.unclipped_pushes = unclipped_pushes
+        hints = problem.planning
+        self.directions = tuple(hints.push_directions or DIRECTIONS)
+        self.push_distances = tuple(hints.push_distances or ())
+        self.place_angles = tuple(hints.place_angles or ())
+        self.place_unc = problem.uncertainty.place
+        self.push_unc = problem.uncertainty.push
+        self.manipulators = tuple(_describe(spec) for spec in problem.manipulators)
+        self.wall_trains = self._wall_trains()
+        self.offsets = {
+            spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
+            for spec in problem.parts
+        }
+
+    def _grid(self, spec: ObjectSpec) -> tuple[tuple[float, float], ...]:
+        nominal = self.checker.shadow_box(spec.name, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        shadow = self.checker.shadow_box(spec.name, (0.0, 0.0, 0.0), self.place_unc)
+        growth = max(nominal[0] - shadow[0], nominal[1] - shadow[1])
+        step = round(growth + 0.1, 3)
+        return tuple((i * step, j * step) for j in (1, 0, -1) for i in (-1, 0, 1))
+
+    def _wall_trains(self) -> dict[tuple[str, str], tuple[str, ...] | None]:
+        """For each part with an absolute goal and each direction: the train of goal parts
+        that holds it against the wall ahead in the goal arrangement (parts touching in a row
+        or column, ending at the wall), or None when the goal does not hold it there.
+
+        Pushing a part to a wall is a step towards the goal only when the goal holds it there
+        and the whole train ahead of it is already on the table; otherwise the push carries it
+        (and whatever is ahead) past the targets.
+        """
+        goal = self.problem.goal
+        if goal.is_relative:
+            return {}
+        slack = 2.0 * max(goal.tolerance[0], goal.tolerance[1]) + 1e-6
+        boxes = {p: self.checker.shadow_box(p, goal.target(p), (0.0, 0.0, 0.0)) for p in goal.parts}
+        width, depth = self.problem.table.size
+        trains: dict[tuple[str, str], tuple[str, ...] | None] = {}
+        for part in goal.parts:
+            for direction, (ux, uy) in DIRECTIONS.items():
+                axis, sign = (0, int(ux)) if ux else (1, int(uy))
+                other = 1 - axis
+                box, train = boxes[part], [part]
+                while True:
+                    front = box[axis + 2] if sign > 0 else -box[axis]
+                    ahead = [
+                        q
+                        for q, b in boxes.items()
+                        if q not in train
+                        and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
+                        and abs((b[axis] if sign > 0 else -b[axis + 2]) - front) <= slack
+                    ]
+                    if not ahead:
+                        break
+                    train.append(ahead[0])
+                    box = boxes[ahead[0]]
+                wall = (width if axis == 0 else depth) if sign > 0 else 0.0
+                held = abs(sign * wall - front) <= slack
+                trains[(part, direction)] = tuple(train[1:]) if held else None
+        return trains
+
+    # -- all candidates --------------------------------------------------------------------
+    def candidates(self, belief: IntervalBelief) -> list[Action]:
+        """Every applicable candidate action of ``belief`` (preconditions hold), in a fixed
+        order: places, then pushes, then picks."""
+        actions: list[Action] = []
+        actions.extend(self.places(belief))
+        actions.extend(self.pushes(belief))
+        actions.extend(self.picks(belief))
+        return actions
+
+    # -- place -----------------------------------------------------------------------------
+    def place_target(self, name: str, belief: IntervalBelief) -> Pose | None:
+        """Where ``name`` should end according to the goal, given ``belief`` (None if unknown)."""
+        goal = self.problem.goal
+        if name not in goal.parts:
+            return None
+        target = goal.target(name)
+        if goal.reference is None:
+            return target
+        ref = belief.get(goal.reference)
+        if ref is None:
+            return None
+        rx, ry, rt = ref.center
+        c, s = math.cos(rt), math.sin(rt)
+        return (
+            rx + c * target[0] - s * target[1],
+            ry + s * target[0] + c * target[1],
+            rt + target[2],
+        )
+
+    def places(self, belief: IntervalBelief, only: str | None = None) -> list[Place]:
+        """Place candidates of every goal part off the table (or of ``only``)."""
+        on_table = self._shadows(belief)
+        actions = []
+        for spec in self.problem.parts:
+            if spec.name in belief or (only is not None and spec.name != only):
+                continue
+            target = self.place_target(spec.name, belief)
+            if target is None:
+                continue
+            angles = self._place_angles(target)
+            for dx, dy in self.offsets[spec.name]:
+                for theta in angles:
+                    pose = (target[0] + dx, target[1] + dy, theta)
+                    if self._place_ok(spec.name, pose, self.place_unc, on_table):
+                        actions.append(Place(spec.name, _clean(pose)))
+        return actions
+
+    def place_poses(self, belief: IntervalBelief, name: str) -> list[Pose]:
+        """Candidate place poses of ``name`` that fit the table, walls and obstacles, whatever
+        the objects on the table (those are the precondition's other half)."""
+        target = self.place_target(name, belief)
+        if target is None:
+            return []
+        poses = []
+        angles = self._place_angles(target)
+        for dx, dy in self.offsets[name]:
+            for theta in angles:
+                pose = (target[0] + dx, target[1] + dy, theta)
+                if self.checker.shadow_inside_table(
+                    name, pose, self.place_unc
+                ) and not self.checker.shadow_hits_fixed(name, pose, self.place_unc):
+                    poses.append(pose)
+        return poses
+
+    def _place_angles(self, target: Pose) -> tuple[float, ...]:
+        """The target's angle, then each ``planning.place_angles`` offset from it, once each."""
+        return tuple(dict.fromkeys((target[2],) + tuple(target[2] + a for a in self.place_angles)))
+
+    def _place_ok(self, name, pose, half, on_table) -> bool:
+        return self.checker.shadow_inside_table(name, pose, half) and self.checker.shadow_clear(
+            name, pose, half, on_table
+        )
+
+    # -- push ------------------------------------------------------------------------------
+    def pushes(self, belief: IntervalBelief) -> list[Push]:
+        on_table = self._shadows(belief)
+        actions: list[Push] = []
+        for manip in self.manipulators:
+            if manip.spec.name in belief:
+                continue
+            for spec in self.problem.parts:
+                interval = belief.get(spec.name)
+                if interval is None:
+                    continue
+                for direction in self.directions:
+                    actions.extend(
+                        self._pushes_of(manip, spec.name, interval, direction, belief, on_table)
+                    )
+        return actions
+
+    def _pushes_of(self, manip, name, interval, direction, belief, on_table) -> list[Push]:
+        ux, uy = DIRECTIONS[direction]
+        axis = 0 if ux else 1
+        sign = int(ux + uy)  # +1 or -1
+        target = self.place_target(name, belief)
+        tolerance = self.problem.goal.tolerance[axis]
+        if target is not None and sign * (target[axis] - interval.center[axis]) < -tolerance:
+            return []  # it would push the part away from where it must end
+        theta = wrap_angle(math.atan2(uy, ux) - manip.push_angle, 0.0, 2.0 * math.pi)
+        part_box = self.checker.shadow_box(name, interval.center, interval.half)
+        # Extents of the manipulator's approach shadow relative to its commanded centre.
+        m_box = self.checker.shadow_box(manip.spec.name, (0.0, 0.0, theta), self.push_unc)
+        # Along the push: the manipulator's shadow front stops APPROACH_GAP short of the part's.
+        if sign > 0:
+            along = part_box[axis] - APPROACH_GAP - m_box[axis + 2]
+        else:
+            along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
+        front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
+        distances = self._distances(name, interval, belief, axis, sign, front_nominal)
+        pushes = []
+        for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
+            pose = (along, across, theta) if axis == 0 else (across, along, theta)
+            if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
+                pushes.extend(
+                    Push(manip.spec.name, _clean(pose), round(float(d), 4)) for d in distances
+                )
+        return pushes
+
+    def _across(self, manip, name, interval, axis, sign, along, m_box, on_table) -> list[float]:
+        """Where to centre the manipulator across the push (at most two centres).
+
+        The first is as near the part's centre as the walls and the shadows beside the approach
+        allow, while the manipulator's long side still covers the part's centre (with 0.1 in to
+        spare). With ``unclipped_pushes``, when it clips the side of a shadow *ahead* of the
+        approach (the manipulator's span overlaps that shadow's span without covering it whole,
+        so the contact may or may not happen), the second is the nearest centre at which every
+        shadow ahead is either missed or covered whole. Empty if no centre fits.
+        """
+        other = 1 - axis
+        centre = interval.center[other]
+        reach = 0.5 * manip.length - 0.1
+        low_lim, high_lim = self._across_limits(other)
+        low = max(centre - reach, low_lim - m_box[other])
+        high = min(centre + reach, high_lim - m_box[other + 2])
+        if low > high:
+            return []
+        a_lo, a_hi = along + m_box[axis], along + m_box[axis + 2]
+        boxes = [
+            self.checker.shadow_box(other_name, pose, half)
+            for other_name, pose, half in on_table
+            if other_name != name
+        ]
+        # Shadows (and obstacles) level with the approach forbid the centres that would make
+        # them overlap: each gives the open interval of such centres.
+        forbidden = [
+            (
+                box[other] - m_box[other + 2] - APPROACH_GAP,
+                box[other + 2] - m_box[other] + APPROACH_GAP,
+            )
+            for box in boxes + list(self.checker.obstacle_boxes.values())
+            if box[axis + 2] > a_lo - APPROACH_GAP and box[axis] < a_hi + APPROACH_GAP
+        ]
+        # Shadows ahead (only with unclipped_pushes): the centres at which the approach shadow
+        # touches one (the interval it is forbidden from when level) and those at which the
+        # nominal manipulator covers it whole. Touching without covering is clipping.
+        half_length = 0.5 * manip.length
+        ahead = [
+            (
+                box[other] - m_box[other + 2] - APPROACH_GAP,
+                box[other + 2] - m_box[other] + APPROACH_GAP,
+                box[other + 2] - half_length,
+                box[other] + half_length,
+            )
+            for box in (boxes if self.unclipped_pushes else [])
+            if (
+                box[axis] >= a_hi - APPROACH_GAP
+                if sign > 0
+                else box[axis + 2] <= a_lo + APPROACH_GAP
+            )
+        ]
+        # Candidate centres: the preferred one and the edges of every interval above.
+        candidates = [min(max(centre, low), high)]
+        candidates += [v for bounds in forbidden + ahead for v in bounds if low <= v <= high]
+        candidates.sort(key=lambda v: abs(v - centre))
+        allowed = [v for v in candidates if all(not (lo < v < hi) for lo, hi in forbidden)]
+        if not allowed:
+            return []
+        for value in allowed:
+            if all(
+                not (touch_lo < value < touch_hi) or cover_lo <= value <= cover_hi
+                for touch_lo, touch_hi, cover_lo, cover_hi in ahead
+            ):
+                return [allowed[0]] if abs(value - allowed[0]) <= 1e-6 else [allowed[0], value]
+        return [allowed[0]]
+
+    def _across_limits(self, other: int) -> tuple[float, float]:
+        """The coordinate range across a push that keeps clear of walls on that axis."""
+        walls = set(self.problem.table.walls)
+        size = self.problem.table.size[other]
+        low_name, high_name = ("left", "right") if other == 0 else ("bottom", "top")
+        low = 0.0 + APPROACH_GAP if low_name in walls else -math.inf
+        high = size - APPROACH_GAP if high_name in walls else math.inf
+        return low, high
+
+    def _distances(self, name, interval, belief, axis, sign, front) -> list[float]:
+        """Candidate travel distances of the manipulator (see the module docstring)."""
+        size = self.problem.table.size[axis]
+        wall = {(0, 1): "right", (0, -1): "left", (1, 1): "top", (1, -1): "bottom"}[(axis, sign)]
+        nominal = self.checker.shadow_box(name, interval.center, (0.0, 0.0, 0.0))
+        rear = sign * (nominal[axis] if sign > 0 else nominal[axis + 2])
+        gap = rear - front  # nominal free travel before contact
+        candidates = []
+        direction = {(0, 1): "+x", (0, -1): "-x", (1, 1): "+y", (1, -1): "-y"}[(axis, sign)]
+        train = self.wall_trains.get((name, direction), ())
+        if (
+            wall in self.problem.table.walls
+            and train is not None
+            and all(q in belief for q in train)
+        ):
+            boundary = size if sign > 0 else 0.0
+            candidates.append(sign * boundary - front)
+        target = self.place_target(name, belief)
+        if target is not None:
+            travel = sign * (target[axis] - interval.center[axis])
+            if travel > MIN_PUSH:
+                candidates.append(gap + travel)
+        candidates.extend(gap + d for d in self.push_distances)
+        result: list[float] = []
+        for d in sorted(candidates):
+            if d > gap + MIN_PUSH and all(abs(d - r) > DISTANCE_RESOLUTION for r in result):
+                result.append(d)
+        return result
+
+    # -- pick ------------------------------------------------------------------------------
+    def picks(self, belief: IntervalBelief) -> list[Pick]:
+        kinds = (ObjectKind.FIXTURE, ObjectKind.MANIPULATOR)
+        return [Pick(name) for name in belief.names() if self.problem.object(name).kind in kinds]
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _shadows(self, belief: IntervalBelief):
+        return [(name, iv.center, iv.half) for name, iv in belief.objects]
+
+
+def _describe(spec: ObjectSpec) -> _Manipulator:
+    xmin, ymin, xmax, ymax = spec.shape.extent
+    px, py = spec.push_direction
+    length, thickness = (xmax - xmin, ymax - ymin) if py else (ymax - ymin, xmax - xmin)
+    return _Manipulator(spec, length, thickness, math.atan2(py, px))
+
+
+def _clean(pose: Pose) -> Pose:
+    """Round a generated pose's position to 1e-6 in so plans print and compare cleanly. The
+    angle is kept exact: it comes from exact axis directions (``-pi/2`` converts to exactly
+    -90 degrees only unrounded)."""
+    return (round(float(pose[0]), 6) + 0.0, round(float(pose[1]), 6) + 0.0, float(pose[2]) + 0.0)

@@ -1,0 +1,224 @@
+"""Search heuristics of the thesis (§2.2.2, §3.2), evaluated on particle beliefs.
+
+A particle belief's heuristic is computed from the interval fitted over its particles, which
+for the per-dimension count equals the maximum over particles that the thesis prescribes for
+particle beliefs (§3.1): an interval is inside the goal interval iff every particle is.
+
+* ``blind``: 0 everywhere (uniform-cost search).
+* ``manhattan``: the sum over goal parts of the Manhattan distance (x plus y, in inches) from
+  the belief centre to the target (Figure 2-12). Not measured in actions, so neither
+  admissible nor comparable to action costs; useful for greedy search and fixture scoring.
+* ``ordering``: the part-ordering filter (Figure 2-13, §3.2's "admissible" heuristic):
+  infinite when two parts that share a row (column) in the goal sit in that row (column) in the
+  wrong order, so that no sequence of pushes can reorder them, or when a goal part still off
+  the table can never be placed: each of its place candidates overlaps both the current shadow
+  and the goal footprint of some part on the table (parts placed out of order have walled it
+  in; the planner only moves parts towards their goals, so the overlap stays); else 0.
+* ``admissible``: ``ordering`` plus one per goal part not yet on the table (each needs at least
+  one place action). Still admissible, and a little better informed than the bare filter.
+* ``inadmissible``: §3.2's per-dimension count: per goal part 2 if it is off the table, 2 if
+  neither its x nor its y interval lies within the goal interval, 1 if exactly one does, else 0
+  — plus 1 when x and y do but the angle interval does not (our goals also constrain the
+  angle) — combined with the ordering filter. Beliefs with equal counts are ordered by a
+  fraction below one that grows with their Manhattan distance (a tie-breaker: it never
+  outweighs a unit of the count).
+
+The ordering filter applies to absolute goals only: for a relative goal the rows and columns
+turn with the reference part.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from arrange_up.belief.goals import EPS, GoalTest
+from arrange_up.belief.states import ParticleBelief
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.planning.actions import ActionGenerator
+
+HEURISTICS = ("inadmissible", "admissible", "ordering", "manhattan", "blind")
+
+Heuristic = Callable[[ParticleBelief], float]
+
+
+def make_heuristic(
+    name: str,
+    problem: ArrangementProblem,
+    goal: GoalTest,
+    checker: CollisionChecker,
+    generator: ActionGenerator | None = None,
+) -> Heuristic:
+    """Build the named heuristic for one problem (see the module docstring).
+
+    ``generator`` (the planner's action generator) lets the ordering filter recognise goal
+    parts that can no longer be placed; without it that part of the filter is off.
+    """
+    if name not in HEURISTICS:
+        raise ValueError(f"unknown heuristic {name!r}; expected one of {', '.join(HEURISTICS)}")
+    ordering = _OrderingFilter(problem, goal, checker, generator)
+
+    def blind(_: ParticleBelief) -> float:
+        return 0.0
+
+    def manhattan(belief: ParticleBelief) -> float:
+        coords = _coords(goal, belief)
+        total = 0.0
+        for k, part in enumerate(goal.parts):
+            if coords is None or part not in belief.names():
+                continue
+            center = 0.5 * (coords[:, k, :2].min(axis=0) + coords[:, k, :2].max(axis=0))
+            total += float(np.abs(center - goal.targets[k, :2]).sum())
+        return total
+
+    def admissible(belief: ParticleBelief) -> float:
+        if ordering.violated(belief):
+            return math.inf
+        return float(sum(1 for p in goal.parts if p not in belief.names()))
+
+    # The count is coarse: many beliefs share a value. A fraction below one, growing with
+    # the Manhattan distance, orders beliefs of equal count by how far their parts still are
+    # from the goal, without ever outweighing one unit of the count.
+    span = (len(goal.parts) + 1) * (problem.table.width + problem.table.depth) + 1.0
+
+    def inadmissible(belief: ParticleBelief) -> float:
+        if ordering.violated(belief):
+            return math.inf
+        return per_dimension_count(goal, belief) + min(manhattan(belief) / span, 0.999)
+
+    return {
+        "blind": blind,
+        "manhattan": manhattan,
+        "ordering": lambda b: math.inf if ordering.violated(b) else 0.0,
+        "admissible": admissible,
+        "inadmissible": inadmissible,
+    }[name]
+
+
+def per_dimension_count(goal: GoalTest, belief: ParticleBelief) -> float:
+    """The §3.2 count (see the module docstring), without the ordering filter."""
+    names = belief.names()
+    present = [p in names for p in goal.parts]
+    if goal.reference is not None and goal.reference not in names:
+        present = [False] * len(goal.parts)
+    total = 2.0 * sum(1 for ok in present if not ok)
+    if not any(present):
+        return total
+    coords = _coords_partial(goal, belief, present)
+    low, high = coords.min(axis=0), coords.max(axis=0)
+    inside = (low >= goal.targets - goal.tolerance - EPS) & (
+        high <= goal.targets + goal.tolerance + EPS
+    )
+    for k, ok in enumerate(present):
+        if not ok:
+            continue
+        x_in, y_in, theta_in = bool(inside[k, 0]), bool(inside[k, 1]), bool(inside[k, 2])
+        total += (not x_in) + (not y_in)
+        if x_in and y_in and not theta_in:
+            total += 1
+    return total
+
+
+def _coords(goal: GoalTest, belief: ParticleBelief) -> np.ndarray | None:
+    return goal.coordinates(belief.poses, belief.names())
+
+
+def _coords_partial(goal: GoalTest, belief: ParticleBelief, present: list[bool]) -> np.ndarray:
+    """Goal coordinates of every goal part; absent parts are padded with their own targets so
+    one vectorised call serves all parts (their rows are ignored by the caller)."""
+    names = list(belief.names())
+    poses = belief.poses
+    absent = [k for k, ok in enumerate(present) if not ok]
+    if absent:
+        extra = np.broadcast_to(goal.targets[absent], (len(belief), len(absent), 3))
+        poses = np.concatenate([poses, extra], axis=1)
+        names += [goal.parts[k] for k in absent]
+    coords = goal.coordinates(poses, names)
+    assert coords is not None
+    return coords
+
+
+class _OrderingFilter:
+    """Detects goal parts that share a goal row/column but sit in it in the wrong order."""
+
+    def __init__(
+        self,
+        problem: ArrangementProblem,
+        goal: GoalTest,
+        checker: CollisionChecker,
+        generator: ActionGenerator | None,
+    ):
+        self.checker = checker
+        self.generator = generator if goal.reference is None else None
+        self.goal = goal
+        self.goal_parts = goal.parts
+        self.targets = {p: tuple(goal.targets[k]) for k, p in enumerate(goal.parts)}
+        self.pairs: list[tuple[str, str, int]] = []  # (a, b, axis): goal has a before b on axis
+        if goal.reference is not None:
+            return
+        boxes = {
+            p: checker.shadow_box(p, tuple(goal.targets[k]), (0.0, 0.0, 0.0))
+            for k, p in enumerate(goal.parts)
+        }
+        for i, a in enumerate(goal.parts):
+            for b in goal.parts[i + 1 :]:
+                for axis in (0, 1):
+                    other = 1 - axis
+                    ba, bb = boxes[a], boxes[b]
+                    share = min(ba[other + 2], bb[other + 2]) - max(ba[other], bb[other]) > EPS
+                    if not share:
+                        continue
+                    ca = goal.targets[goal.parts.index(a), axis]
+                    cb = goal.targets[goal.parts.index(b), axis]
+                    if ca < cb - EPS:
+                        self.pairs.append((a, b, axis))
+                    elif cb < ca - EPS:
+                        self.pairs.append((b, a, axis))
+
+    def violated(self, belief: ParticleBelief) -> bool:
+        intervals = belief.intervals
+        if self.generator is not None and len(intervals.objects) < len(self.goal_parts):
+            placed = [(q, iv) for q, iv in intervals.objects if q in self.targets]
+            for part in self.goal_parts:
+                if part not in intervals and self._walled_in(part, intervals, placed):
+                    return True
+        return self._row_order_violated(intervals)
+
+    def _walled_in(self, part: str, intervals, placed) -> bool:
+        """True if every place candidate of ``part`` is blocked for good.
+
+        A candidate is blocked for good by a goal part ``q`` on the table when it overlaps both
+        ``q``'s current shadow and ``q``'s goal footprint: the planner only ever moves ``q``
+        towards its goal, and between two overlapping positions ``q`` keeps overlapping.
+        """
+        assert self.generator is not None
+        half = self.generator.place_unc
+        none = (0.0, 0.0, 0.0)
+        for pose in self.generator.place_poses(intervals, part):
+            candidate = (part, pose, half)
+            if not any(
+                self.checker.shadows_overlap(candidate, (q, iv.center, iv.half))
+                and self.checker.shadows_overlap(candidate, (q, self.targets[q], none))
+                for q, iv in placed
+            ):
+                return False
+        return True
+
+    def _row_order_violated(self, intervals) -> bool:
+        for a, b, axis in self.pairs:
+            ia, ib = intervals.get(a), intervals.get(b)
+            if ia is None or ib is None:
+                continue
+            box_a = self.checker.shadow_box(a, ia.center, ia.half)
+            box_b = self.checker.shadow_box(b, ib.center, ib.half)
+            other = 1 - axis
+            same_line = (
+                min(box_a[other + 2], box_b[other + 2]) - max(box_a[other], box_b[other]) > EPS
+            )
+            # Wrong order: a must end before b along the axis, but lies entirely beyond it.
+            if same_line and box_a[axis] >= box_b[axis + 2] - EPS:
+                return True
+        return False

@@ -1,0 +1,342 @@
+"""Compile an arrangement problem to a unified-planning ``Problem``, and map it back.
+
+:func:`to_up` builds a UP model of an :class:`~arrange_up.model.problem.ArrangementProblem`:
+
+* **Types** ``movable`` (every object that can be on or off the table) with subtypes
+  ``placeable`` (``part``, ``fixture``) and ``manipulator``; ``obstacle`` for fixed objects
+  (which have no fluents: they never move).
+* **Fluents** of movables: ``on_table(o)`` (bool, default false) and the pose ``x(o)``,
+  ``y(o)``, ``theta(o)`` (real, default 0, meaningless while ``o`` is off the table). For a
+  relative goal also ``rel_x(p)``, ``rel_y(p)``, ``rel_theta(p)``: the pose of part ``p`` in the
+  reference part's frame.
+* **Actions** ``place(o - placeable, px, py, ptheta)``: precondition ``not on_table(o)``;
+  ``push(m - manipulator, px, py, ptheta, distance)``: precondition ``not on_table(m)`` (the
+  approach pose ``px, py, ptheta``; the push drives ``distance`` inches perpendicular to the
+  manipulator's long side, then lifts it off); ``pick(o - movable)``: precondition
+  ``on_table(o)``, effect ``not on_table(o)``. Place and push poses are real parameters; what
+  they do to the poses is not symbolic: simulated effects resolve it by the chosen semantics
+  (:mod:`arrange_up.up.effects`). Place also sets ``on_table(o)``.
+* **Goals**, one condition each: ``on_table(p)`` and ``target - tol <= f(p) <= target + tol``
+  for ``f`` in ``x``, ``y``, ``theta`` of each goal part (no ``theta`` condition when the
+  tolerance allows any angle). A relative goal constrains ``rel_x``, ``rel_y``, ``rel_theta``
+  instead, and needs ``on_table`` of the reference too.
+
+**Units.** The UP model uses **inches and degrees**, like the ``.pddl`` files, whatever the
+problem file used: numbers a user reads in a UP plan are the numbers they would write. All
+numbers are exact ``Fraction`` constants of the decimals they stand for (9 decimals), never the
+binary fractions that Python floats would become.
+
+**Angles modulo symmetry.** The planner treats an angle modulo the shape's rotational symmetry
+(a square block turned 90 degrees is the same block). The effects therefore write ``theta`` wrapped
+into the symmetry period around the goal angle (``rel_theta`` around the relative target), as
+the planner's beliefs store it, so the interval conditions mean what the planner's goal test
+means (see :mod:`arrange_up.up.effects`).
+
+:func:`from_up` maps a UP problem back to the :class:`ArrangementProblem`: for one made by
+:func:`to_up` (or a clone of one) through its effects, which carry the problem and a
+fingerprint of the UP content (a problem edited after compiling is refused rather than
+silently mapped back to the original); for one read by UP's ``PDDLReader`` by rebuilding it from
+the PDDL vocabulary (:mod:`arrange_up.io.pddl`).
+
+Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl` and
+:mod:`arrange_up.up.engines` import unified-planning.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from arrange_up.model.problem import ArrangementProblem, ObjectKind
+from arrange_up.model.world import Action, Pick, Place, Push, nominal_initial_state
+from arrange_up.up.effects import (
+    NOMINAL_SEMANTICS,
+    PoseFluents,
+    TransitionEffect,
+    attach_effects,
+    check_semantics,
+    exact,
+    exact_degrees,
+)
+
+__all__ = [
+    "ACTION_NAMES",
+    "FLUENT_NAMES",
+    "NOMINAL_SEMANTICS",
+    "TYPE_NAMES",
+    "from_up",
+    "made_by_to_up",
+    "plan_from_up",
+    "plan_to_up",
+    "to_up",
+]
+
+TYPE_NAMES = ("movable", "placeable", "part", "fixture", "manipulator", "obstacle")
+FLUENT_NAMES = ("on_table", "x", "y", "theta", "rel_x", "rel_y", "rel_theta")
+ACTION_NAMES = ("place", "push", "pick")
+_KIND_TYPE = {
+    ObjectKind.PART: "part",
+    ObjectKind.FIXTURE: "fixture",
+    ObjectKind.MANIPULATOR: "manipulator",
+    ObjectKind.OBSTACLE: "obstacle",
+}
+
+
+def to_up(
+    problem: ArrangementProblem, semantics: str = "deterministic", *, environment: Any = None
+) -> Any:
+    """The unified-planning ``Problem`` of ``problem`` (see the module docstring).
+
+    ``semantics`` resolves the effects of place and push; only ``deterministic`` (alias
+    ``nominal``) can be compiled, since a UP state is a single world state. ``environment``
+    is a UP ``Environment`` (default: the global one).
+
+    Raises ``ValueError`` for another semantics or for an object named like one of the model's
+    types, fluents or actions (unified-planning refuses such a clash).
+    """
+    import unified_planning.model as m
+    from unified_planning.environment import get_environment
+
+    check_semantics(semantics)
+    _check_names(problem)
+    env = get_environment(environment)
+    em, tm = env.expression_manager, env.type_manager
+    up = m.Problem(problem.name, environment=env)
+
+    movable = tm.UserType("movable")
+    placeable = tm.UserType("placeable", movable)
+    types = {
+        "part": tm.UserType("part", placeable),
+        "fixture": tm.UserType("fixture", placeable),
+        "manipulator": tm.UserType("manipulator", movable),
+        "obstacle": tm.UserType("obstacle"),
+    }
+    real = tm.RealType()
+    fluents = {
+        "on_table": m.Fluent("on_table", tm.BoolType(), o=movable, environment=env),
+        "x": m.Fluent("x", real, o=movable, environment=env),
+        "y": m.Fluent("y", real, o=movable, environment=env),
+        "theta": m.Fluent("theta", real, o=movable, environment=env),
+    }
+    up.add_fluent(fluents["on_table"], default_initial_value=False)
+    for key in ("x", "y", "theta"):
+        up.add_fluent(fluents[key], default_initial_value=0)
+
+    objects = {}
+    for spec in problem.objects:
+        objects[spec.name] = m.Object(spec.name, types[_KIND_TYPE[spec.kind]], env)
+        up.add_object(objects[spec.name])
+    movable_names = tuple(s.name for s in problem.objects if s.kind is not ObjectKind.OBSTACLE)
+
+    def table(key: str) -> dict[str, Any]:
+        return {name: fluents[key](objects[name]) for name in movable_names}
+
+    rel: dict[str, tuple[Any, Any, Any]] = {}
+    if problem.goal.reference is not None:
+        rel_fluents = [
+            m.Fluent(name, real, p=types["part"], environment=env)
+            for name in ("rel_x", "rel_y", "rel_theta")
+        ]
+        for fluent in rel_fluents:
+            up.add_fluent(fluent, default_initial_value=0)
+        rel = {
+            part: tuple(f(objects[part]) for f in rel_fluents)  # type: ignore[misc]
+            for part in problem.goal.parts
+        }
+    pose_fluents = PoseFluents(
+        fluents,
+        movable_names,
+        table("on_table"),
+        table("x"),
+        table("y"),
+        table("theta"),
+        rel,
+    )
+
+    # -- actions ---------------------------------------------------------------------------
+    width, depth = exact(problem.table.width), exact(problem.table.depth)
+    place = m.InstantaneousAction(
+        "place",
+        o=placeable,
+        px=tm.RealType(0, width),
+        py=tm.RealType(0, depth),
+        ptheta=real,
+        _env=env,
+    )
+    place.add_precondition(em.Not(fluents["on_table"](place.parameter("o"))))
+    place.add_effect(fluents["on_table"](place.parameter("o")), True)
+    push = m.InstantaneousAction(
+        "push",
+        m=types["manipulator"],
+        px=real,
+        py=real,
+        ptheta=real,
+        distance=tm.RealType(0, None),
+        _env=env,
+    )
+    push.add_precondition(em.Not(fluents["on_table"](push.parameter("m"))))
+    pick = m.InstantaneousAction("pick", o=movable, _env=env)
+    pick.add_precondition(fluents["on_table"](pick.parameter("o")))
+    pick.add_effect(fluents["on_table"](pick.parameter("o")), False)
+    effects = attach_effects(problem, semantics, place, push, pose_fluents)
+    has_manipulator = bool(problem.manipulators)
+    for action in (place, push, pick):
+        if action is push and not has_manipulator:
+            continue  # a push action over an empty type would be dead weight
+        up.add_action(action)
+
+    # -- initial state ---------------------------------------------------------------------
+    from arrange_up.belief.states import AngleFrame
+
+    start = AngleFrame.of(problem).canonical(nominal_initial_state(problem))
+    for name in start.names():
+        up.set_initial_value(pose_fluents.on_table[name], True)
+    for fluent, value in pose_fluents.values(problem, start).items():
+        up.set_initial_value(fluent, em.Real(value))
+
+    # -- goals -----------------------------------------------------------------------------
+    for condition in _goal_conditions(problem, pose_fluents, em):
+        up.add_goal(condition)
+
+    fingerprint = _fingerprint(up)
+    for effect in effects:
+        effect.fingerprint = fingerprint
+    return up
+
+
+def _goal_conditions(problem: ArrangementProblem, fl: PoseFluents, em: Any) -> list[Any]:
+    goal = problem.goal
+    tol_x, tol_y, tol_theta = goal.tolerance
+    out = []
+    if goal.reference is not None:
+        out.append(fl.on_table[goal.reference])
+    for part, (tx, ty, ttheta) in goal.targets:
+        out.append(fl.on_table[part])
+        if goal.reference is None:
+            fx, fy, ftheta = fl.x[part], fl.y[part], fl.theta[part]
+        else:
+            fx, fy, ftheta = fl.rel[part]
+        bounds = [(fx, exact(tx), exact(tol_x)), (fy, exact(ty), exact(tol_y))]
+        if tol_theta is not None:
+            bounds.append((ftheta, exact_degrees(ttheta), exact_degrees(tol_theta)))
+        for fluent, target, tol in bounds:
+            out.append(em.GE(fluent, em.Real(target - tol)))
+            out.append(em.LE(fluent, em.Real(target + tol)))
+    return out
+
+
+def _check_names(problem: ArrangementProblem) -> None:
+    reserved = set(TYPE_NAMES + FLUENT_NAMES + ACTION_NAMES)
+    clashes = [spec.name for spec in problem.objects if spec.name in reserved]
+    if clashes:
+        raise ValueError(
+            f"problem {problem.name!r}: object name(s) {', '.join(map(repr, clashes))} clash "
+            "with the unified-planning model's vocabulary (types "
+            f"{', '.join(TYPE_NAMES)}; fluents {', '.join(FLUENT_NAMES)}; actions "
+            f"{', '.join(ACTION_NAMES)}); unified-planning refuses two elements with one name: "
+            "rename the object"
+        )
+
+
+def _fingerprint(up_problem: Any) -> str:
+    """A digest of what a user could edit in a compiled problem: objects, initial values,
+    goals and action names. A clone has the same fingerprint."""
+    lines = [f"name {up_problem.name}"]
+    lines += sorted(f"object {o.name} - {o.type}" for o in up_problem.all_objects)
+    lines += sorted(f"init {k} = {v}" for k, v in up_problem.explicit_initial_values.items())
+    lines += [f"goal {g}" for g in up_problem.goals]
+    lines += [f"action {a.name}" for a in up_problem.actions]
+    return hashlib.sha256("\n".join(lines).encode("utf-8")).hexdigest()
+
+
+def _effect_of(up_problem: Any) -> TransitionEffect | None:
+    for action in getattr(up_problem, "actions", ()):
+        effect = getattr(action, "simulated_effect", None)
+        function = getattr(effect, "function", None)
+        if isinstance(function, TransitionEffect):
+            return function
+    return None
+
+
+def made_by_to_up(up_problem: Any) -> bool:
+    """True if ``up_problem`` was made by :func:`to_up` (or is a clone of such a problem)."""
+    return _effect_of(up_problem) is not None
+
+
+def from_up(up_problem: Any) -> ArrangementProblem:
+    """The :class:`ArrangementProblem` of a unified-planning problem.
+
+    * Made by :func:`to_up` (or cloned from one): the compiled problem, found through the
+      problem's effects. Raises ``ValueError`` if the UP problem was edited since (objects,
+      initial values, goals or actions differ from what :func:`to_up` made).
+    * Read by UP's ``PDDLReader`` with arrange-up's domain: rebuilt from the PDDL vocabulary
+      (:func:`arrange_up.io.pddl.problem_from_up`); raises
+      :class:`~arrange_up.model.errors.ProblemFormatError` (a ``ValueError``) when it does not fit
+      the vocabulary. Names are as UP read them: lowercase, since PDDL is case-insensitive
+      (:func:`arrange_up.io.pddl.load_pddl_problem` restores the written case from the file).
+    """
+    effect = _effect_of(up_problem)
+    if effect is not None:
+        if effect.fingerprint != _fingerprint(up_problem):
+            raise ValueError(
+                f"unified-planning problem {up_problem.name!r} was made by "
+                "arrange_up.up.compile.to_up but has been edited since (its objects, initial "
+                "values, goals or actions differ); edits to a compiled problem cannot be mapped "
+                "back: change the ArrangementProblem and compile it again"
+            )
+        return effect.problem
+    from arrange_up.io.pddl import problem_from_up
+
+    return problem_from_up(up_problem)
+
+
+# ---------------------------------------------------------------------------------------------
+# plans
+# ---------------------------------------------------------------------------------------------
+def plan_to_up(up_problem: Any, actions: Sequence[Action]) -> Any:
+    """A UP ``SequentialPlan`` of arrange-up actions (inches, radians) for a problem made by
+    :func:`to_up`: real parameters are exact decimals (9 places), angles in degrees."""
+    from unified_planning.plans import ActionInstance, SequentialPlan
+
+    em = up_problem.environment.expression_manager
+    out = []
+    for action in actions:
+        if isinstance(action, Place):
+            params = [up_problem.object(action.obj), *_pose_params(em, action.pose)]
+            out.append(ActionInstance(up_problem.action("place"), params))
+        elif isinstance(action, Push):
+            params = [up_problem.object(action.manipulator), *_pose_params(em, action.pose)]
+            params.append(em.Real(exact(action.distance)))
+            out.append(ActionInstance(up_problem.action("push"), params))
+        elif isinstance(action, Pick):
+            out.append(ActionInstance(up_problem.action("pick"), [up_problem.object(action.obj)]))
+        else:
+            raise TypeError(f"not an arrange-up action: {action!r}")
+    return SequentialPlan(out, environment=up_problem.environment)
+
+
+def plan_from_up(plan: Any) -> tuple[Action, ...]:
+    """The arrange-up actions (inches, radians) of a UP ``SequentialPlan`` over the model of
+    :func:`to_up`."""
+    out: list[Action] = []
+    for instance in plan.actions:
+        name = instance.action.name
+        params = instance.actual_parameters
+        if name == "pick":
+            out.append(Pick(params[0].object().name))
+            continue
+        x, y, theta = (float(p.constant_value()) for p in params[1:4])
+        pose = (x, y, math.radians(theta))
+        if name == "place":
+            out.append(Place(params[0].object().name, pose))
+        elif name == "push":
+            out.append(Push(params[0].object().name, pose, float(params[4].constant_value())))
+        else:
+            raise ValueError(f"action {name!r} is not place, push or pick")
+    return tuple(out)
+
+
+def _pose_params(em: Any, pose: Sequence[float]) -> list[Any]:
+    return [em.Real(exact(pose[0])), em.Real(exact(pose[1])), em.Real(exact_degrees(pose[2]))]

@@ -1,0 +1,129 @@
+"""The arrange-up command: exit statuses, outputs, and clean errors on bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+from click.testing import CliRunner
+
+from arrange_up.cli.commands import main
+
+BAD = textwrap.dedent(
+    """\
+    name: bad
+    table: {size: [10, 5]}
+    objects:
+      A: {kind: gizmo, shape: {box: [1, 1]}}
+    goal:
+      poses: {Z: [1, 1, 0]}
+    """
+)
+
+
+def run(*args: str):
+    return CliRunner().invoke(main, list(args), catch_exceptions=False)
+
+
+def test_help_lists_the_commands():
+    result = run("--help")
+    assert result.exit_code == 0
+    for command in ("plan", "check", "show", "domains", "export", "bench"):
+        assert command in result.output
+
+
+def test_domains_lists_shipped_problems():
+    result = run("domains")
+    assert result.exit_code == 0
+    assert "blocks-4" in result.output and "tz-mating" in result.output
+
+
+def test_check_accepts_valid_and_reports_every_error(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(BAD)
+    result = CliRunner().invoke(main, ["check", str(bad)])
+    assert result.exit_code == 1
+    assert f"{bad}:4:" in result.output  # the unknown kind, with its line
+    assert f"{bad}:6:" in result.output  # the undeclared goal part, with its line
+    assert "Traceback" not in result.output
+
+
+def test_check_valid_shipped_file_by_path():
+    from arrange_up.io.domains import resolve_problem
+
+    result = run("check", str(resolve_problem("blocks-2")))
+    assert result.exit_code == 0 and "ok: blocks-2" in result.output
+
+
+def test_show_writes_png(tmp_path):
+    out = tmp_path / "b2.png"
+    result = run("show", "blocks-2", "--output", str(out))
+    assert result.exit_code == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plan_json_summary_and_plan_file(tmp_path):
+    out = tmp_path / "plan.json"
+    result = run("plan", "blocks-1", "--semantics", "deterministic", "--json", "--output", str(out))
+    assert result.exit_code == 0
+    summary = json.loads(result.output)
+    assert summary["status"] == "solved" and summary["plan_length"] == len(summary["actions"])
+    assert summary["search"]["expanded"] >= 1
+    document = json.loads(out.read_text())
+    assert document["actions"] == summary["actions"]
+    assert document["units"] == {"length": "in", "angle": "deg"}
+
+
+def test_plan_not_found_exits_1_and_writes_honest_status(tmp_path):
+    out = tmp_path / "plan.json"
+    result = run(
+        "plan", "blocks-2", "--semantics", "deterministic", "--max-nodes", "1", "--output", str(out)
+    )
+    assert result.exit_code == 1
+    document = json.loads(out.read_text())
+    assert document["status"] == "node-limit" and "actions" not in document
+
+
+def test_plan_table_is_readable():
+    result = run("plan", "blocks-1", "--semantics", "deterministic")
+    assert result.exit_code == 0
+    assert "place" in result.output and "push" in result.output and "paddle" in result.output
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["plan", "no-such-domain"],
+        ["plan", "blocks-1", "--semantics", "magic"],
+        ["show", "no-such-domain", "--output", "x.png"],
+    ],
+)
+def test_bad_input_exits_2_without_traceback(args):
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+
+
+def test_bad_problem_file_in_a_subprocess_has_no_traceback(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(BAD)
+    proc = subprocess.run(
+        [sys.executable, "-m", "arrange_up", "plan", str(bad)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert f"{bad}:4:" in proc.stderr and "kind" in proc.stderr
+
+
+def test_export_pddl(tmp_path):
+    out = tmp_path / "b2.pddl"
+    result = run("export", "blocks-2", "--to", "pddl", "--output", str(out))
+    assert result.exit_code == 0
+    text = out.read_text()
+    assert "(define (problem" in text and ":goal" in text

@@ -1,0 +1,220 @@
+"""Tests of the PDDL front end (``arrange_up.io.pddl``) and the shape catalogue."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+
+import pytest
+from unified_planning.io import PDDLReader
+
+from arrange_up.io.domains import domain_names, domains_dir, load
+from arrange_up.io.pddl import (
+    PddlExportError,
+    domain_path,
+    domain_pddl_text,
+    load_pddl_problem,
+    load_pddl_problem_text,
+    write_pddl_problem,
+)
+from arrange_up.io.shape_catalogue import build_shape, load_catalogue
+from arrange_up.model.errors import ProblemFormatError
+from arrange_up.model.problem import (
+    ObjectKind,
+    ObjectSpec,
+    PlanningHints,
+    problem_hash,
+)
+from arrange_up.up.compile import from_up
+
+SHIPPED_PDDL = sorted(p.stem for p in domains_dir().glob("*.pddl"))
+SMALL = ("blocks-1", "blocks-2", "down-push")
+
+
+def _expressible(name: str) -> bool:
+    try:
+        write_pddl_problem(load(name))
+    except PddlExportError:
+        return False
+    return True
+
+
+def test_the_shipped_domain_is_generated_from_the_catalogue():
+    assert domain_path().read_text(encoding="utf-8") == domain_pddl_text()
+
+
+def test_every_shipped_domain_that_pddl_can_express_ships_as_pddl():
+    expressible = [name for name in domain_names() if _expressible(name)]
+    assert expressible  # every shipped problem uses catalogue shapes
+    assert sorted(expressible) == [n for n in SHIPPED_PDDL if n in expressible]
+    assert set(SHIPPED_PDDL) >= set(expressible)
+
+
+@pytest.mark.parametrize("name", SHIPPED_PDDL)
+def test_pddlreader_parses_every_shipped_pddl_unchanged(name):
+    up = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / f"{name}.pddl"))
+    assert up.name == name.lower()
+    assert {a.name for a in up.actions} == {"place", "push", "pick"}
+
+
+@pytest.mark.parametrize("name", SHIPPED_PDDL)
+def test_yaml_and_pddl_give_the_same_problem(name):
+    from_yaml = load(name)
+    path = domains_dir() / f"{name}.pddl"
+    from_pddl = load_pddl_problem(path)
+    assert problem_hash(from_pddl) == problem_hash(from_yaml)
+    assert from_pddl.description == " ".join(from_yaml.description.split())
+    assert from_pddl.source == str(path)
+    # the shipped file is what the writer writes today
+    assert path.read_text(encoding="utf-8") == write_pddl_problem(from_yaml)
+
+
+@pytest.mark.parametrize("name", [n for n in SMALL if n in SHIPPED_PDDL])
+def test_yaml_and_pddl_give_the_same_deterministic_plan(name):
+    from arrange_up.planning.planner import plan
+
+    from_yaml = plan(load(name), semantics="deterministic", seed=0)
+    from_pddl = plan(
+        load_pddl_problem(domains_dir() / f"{name}.pddl"), semantics="deterministic", seed=0
+    )
+    assert from_yaml.solved
+    assert from_pddl.actions == from_yaml.actions
+
+
+def test_names_keep_their_written_case():
+    problem = load_pddl_problem(domains_dir() / "blocks-2.pddl")
+    assert [o.name for o in problem.objects] == ["A", "B", "paddle"]
+    # UP's reader lowercases; from_up of its problem keeps UP's names
+    up = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / "blocks-2.pddl"))
+    assert [o.name for o in from_up(up).objects] == ["a", "b", "paddle"]
+
+
+def test_written_pddl_uses_inches_degrees_and_plain_decimals():
+    text = write_pddl_problem(load("tt-mating"))
+    assert "(= (theta T2) 180)" in text
+    assert "(>= (rel-theta T2 T1) 170) (<= (rel-theta T2 T1) 190)" in text
+    assert "(= (part-density-min) 0.1)" in text
+    assert not re.search(r"\d[eE][-+]?\d", text)  # no exponents: PDDL has none
+
+
+def test_export_refuses_what_pddl_cannot_express():
+    problem = load("blocks-1")
+    odd = build_shape("box", [1.3, 0.7], "odd")
+    refused = dataclasses.replace(
+        problem,
+        objects=(ObjectSpec("A", ObjectKind.PART, odd), *problem.objects[1:]),
+        planning=PlanningHints(push_distances=(1.0,)),
+    )
+    with pytest.raises(PddlExportError) as caught:
+        write_pddl_problem(refused)
+    message = str(caught.value)
+    assert "'blocks-1' cannot be written as PDDL" in message
+    assert (
+        "object 'A': its shape (box 1.3 x 0.7 in) is not a part shape of the catalogue" in message
+    )
+    assert "planning.push_distances" in message
+    assert len(caught.value.reasons) == 2
+
+
+def test_export_refuses_names_pddl_cannot_carry():
+    problem = load("blocks-2")
+    a, b, paddle = problem.objects
+    renamed = dataclasses.replace(
+        problem,
+        name="two blocks",
+        objects=(dataclasses.replace(a, name="theta"), dataclasses.replace(b, name="_b"), paddle),
+    )
+    with pytest.raises(PddlExportError) as caught:
+        write_pddl_problem(renamed)
+    reasons = " | ".join(caught.value.reasons)
+    assert "'two blocks' is not a PDDL name" in reasons
+    assert "object 'theta': the name is taken by the PDDL vocabulary" in reasons
+    assert "object '_b': not a PDDL name" in reasons
+
+
+def test_load_reports_an_unknown_type_with_its_position():
+    text = (domains_dir() / "blocks-1.pddl").read_text().replace("A - block-1x1", "A - blok")
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "b1.pddl")
+    (diagnostic,) = caught.value.diagnostics
+    assert diagnostic.file == "b1.pddl"
+    assert diagnostic.line is not None and diagnostic.column is not None
+    assert "unknown name 'blok'" in diagnostic.message
+    assert "block-1x1" in diagnostic.message
+
+
+def test_load_reports_syntax_errors_with_line_and_column():
+    text = (domains_dir() / "blocks-1.pddl").read_text().replace("(= (table-width) 10)", "(= (")
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "b1.pddl")
+    (diagnostic,) = caught.value.diagnostics
+    assert diagnostic.line is not None
+    assert str(diagnostic).startswith(f"b1.pddl:{diagnostic.line}:")
+
+
+def test_load_reports_vocabulary_errors_together():
+    text = (domains_dir() / "blocks-2.pddl").read_text()
+    text = text.replace("(= (table-width) 10) ", "")
+    text = text.replace("(<= (x B) 8.7)", "(<= (x B) 8.9)")  # B's x half-width 0.3, A's 0.2
+    text = text.replace("(= (friction-max) 0.55)", "")
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "b2.pddl")
+    messages = [d.message for d in caught.value.errors]
+    assert any("missing (table-width)" in m for m in messages)
+    assert any("one tolerance for every goal part" in m for m in messages)
+    assert any("only one of (friction-min) and (friction-max)" in m for m in messages)
+    assert all(d.file == "b2.pddl" for d in caught.value.diagnostics)
+
+
+def test_load_refuses_a_goal_without_both_bounds_and_a_missing_pose():
+    text = (domains_dir() / "down-push.pddl").read_text()
+    text = text.replace("(<= (y block) 3.5)", "").replace("(= (x block) 6) ", "")
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "dp.pddl")
+    messages = " | ".join(d.message for d in caught.value.errors)
+    assert "(y block) has no (<= ...) bound" in messages
+    assert "block is on the table but has no (x block)" in messages
+
+
+def test_load_refuses_another_domain_and_a_missing_file(tmp_path: Path):
+    text = (
+        (domains_dir() / "blocks-1.pddl")
+        .read_text()
+        .replace("(:domain arrange-up)", "(:domain blocksworld)")
+    )
+    with pytest.raises(ProblemFormatError, match="expected 'arrange-up'"):
+        load_pddl_problem_text(text, "b1.pddl")
+    with pytest.raises(ProblemFormatError, match="no such file"):
+        load_pddl_problem(tmp_path / "missing.pddl")
+
+
+def test_catalogue_shapes_match_the_shipped_yaml_shapes():
+    catalogue = load_catalogue()
+    assert catalogue.entry("BLOCK-1X1") is catalogue.entry("block-1x1")
+    tee = load("tt-mating").object("T1").shape
+    assert catalogue.entry("tee").shape == tee
+    assert catalogue.match(ObjectKind.PART, tee).type_name == "tee"
+    assert catalogue.match(ObjectKind.FIXTURE, tee) is None
+    for entry in catalogue.entries:
+        assert entry.type_name.lower() not in {"block", "paddle", "bar"}  # shipped object names
+
+
+def test_obstacles_round_trip():
+    problem = load("blocks-1")
+    pillar = ObjectSpec(
+        "post", ObjectKind.OBSTACLE, build_shape("box", [0.5, 0.5], "post"), (5.0, 2.5, 0.0)
+    )
+    with_post = dataclasses.replace(problem, objects=(*problem.objects, pillar))
+    text = write_pddl_problem(with_post)
+    assert "post - pillar" in text and "(= (x post) 5)" in text
+    assert problem_hash(load_pddl_problem_text(text)) == problem_hash(with_post)
+
+
+def test_a_malformed_catalogue_is_refused(tmp_path: Path):
+    from arrange_up.io.shape_catalogue import CatalogueError
+
+    bad = tmp_path / "shapes.yaml"
+    bad.write_text("format: arrange-up-shapes/1\ntypes:\n  blob: {kind: part, box: [1, -1]}\n")
+    with pytest.raises(CatalogueError, match=r"types\.blob\.box: box size must be positive"):
+        load_catalogue(bad)

@@ -1,0 +1,141 @@
+"""Tests of the unified-planning engine ``arrange-up`` and its registration."""
+
+from __future__ import annotations
+
+import io
+import runpy
+import subprocess
+import sys
+import warnings
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+from unified_planning.engines import PlanGenerationResultStatus as Status
+from unified_planning.engines.results import ValidationResultStatus
+from unified_planning.environment import get_environment
+from unified_planning.io import PDDLReader
+from unified_planning.shortcuts import OneshotPlanner, PlanValidator
+
+import arrange_up.up.engines as engines
+from arrange_up.io.domains import domains_dir, load
+from arrange_up.io.pddl import domain_path
+from arrange_up.up.compile import from_up, to_up
+
+engines.register()  # idempotent; works before or after unified_planning is imported
+
+DETERMINISTIC = {"semantics": "deterministic", "seed": 0}
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _solve(problem, params=None, **kwargs):
+    with OneshotPlanner(name="arrange-up", params=params or DETERMINISTIC) as planner:
+        return planner.solve(problem, **kwargs)
+
+
+@pytest.mark.parametrize("name", ["blocks-1", "blocks-2"])
+def test_plans_are_solved_exact_and_accepted_by_ups_validator(name):
+    problem = to_up(load(name))
+    result = _solve(problem, timeout=60)
+    assert result.status is Status.SOLVED_SATISFICING
+    assert result.engine_name == "arrange-up"
+    assert int(result.metrics["expanded"]) >= 1 and "generated" in result.metrics
+    for instance in result.plan.actions:
+        for param in instance.actual_parameters[1:]:
+            value = param.constant_value()
+            assert isinstance(value, Fraction)
+            assert 10**9 % value.denominator == 0  # a decimal, not a binary fraction
+    with PlanValidator(name="sequential_plan_validator") as validator:
+        check = validator.validate(problem, result.plan)
+    assert check.status is ValidationResultStatus.VALID
+
+
+def test_node_limit_is_reported_honestly():
+    result = _solve(to_up(load("blocks-2")), {**DETERMINISTIC, "max_nodes": 1})
+    assert result.status is Status.UNSOLVABLE_INCOMPLETELY
+    assert result.plan is None
+    assert "node limit of 1" in result.log_messages[0].message
+    assert result.metrics["status"] == "node-limit"
+
+
+def test_the_engine_enforces_the_timeout():
+    result = _solve(to_up(load("blocks-2")), timeout=1e-6)
+    assert result.status is Status.TIMEOUT
+    assert result.plan is None
+
+
+def test_a_problem_read_from_pddl_is_solved():
+    path = domains_dir() / "blocks-1.pddl"
+    up = PDDLReader().parse_problem(str(domain_path()), str(path))
+    result = _solve(up)
+    assert result.status is Status.SOLVED_SATISFICING
+    assert "came from PDDL" in result.log_messages[0].message
+    with PlanValidator(name="sequential_plan_validator") as validator:
+        check = validator.validate(to_up(from_up(up)), result.plan)
+    assert check.status is ValidationResultStatus.VALID
+
+
+def test_a_foreign_problem_is_unsupported():
+    from unified_planning.shortcuts import BoolType, Fluent, InstantaneousAction, Problem
+
+    problem = Problem("lights")
+    on = Fluent("on", BoolType())
+    switch = InstantaneousAction("switch")
+    switch.add_effect(on, True)
+    problem.add_fluent(on, default_initial_value=False)
+    problem.add_action(switch)
+    problem.add_goal(on)
+    result = _solve(problem)
+    assert result.status is Status.UNSUPPORTED_PROBLEM
+    assert "not an arrange-up problem" in result.log_messages[0].message
+
+
+def test_an_ignored_heuristic_warns():
+    stream = io.StringIO()
+    with pytest.warns(UserWarning, match="ignores the heuristic"):
+        result = _solve(to_up(load("blocks-1")), heuristic=lambda state: 0, output_stream=stream)
+    assert result.status is Status.SOLVED_SATISFICING
+
+
+def test_parameters_are_checked():
+    with pytest.raises(ValueError, match="unknown semantics 'nope'"):
+        OneshotPlanner(name="arrange-up", params={"semantics": "nope"})
+    with pytest.raises(ValueError, match="particles must be a positive integer"):
+        OneshotPlanner(name="arrange-up", params={"particles": 0})
+
+
+def test_registration_is_idempotent_and_has_no_credits():
+    engines.register()
+    engines.register()
+    factory = get_environment().factory
+    assert factory.engines.count("arrange-up") == 1
+    cls = engines.ArrangeUpPlanner
+    assert cls.get_credits() is None
+    assert cls.supports(to_up(load("blocks-1")).kind)
+    planner = cls()
+    assert planner.name == "arrange-up"
+
+
+def test_register_before_unified_planning_is_imported():
+    code = (
+        "import sys, arrange_up.up.engines as e\n"
+        "e.register()\n"
+        "assert 'unified_planning' not in sys.modules, 'register imported unified_planning'\n"
+        "from unified_planning.shortcuts import OneshotPlanner\n"
+        "with OneshotPlanner(name='arrange-up', params={'semantics': 'deterministic'}) as p:\n"
+        "    print(p.name)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "arrange-up"
+
+
+def test_the_example_runs(capsys):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        module = runpy.run_path(str(ROOT / "examples" / "plan_with_unified_planning.py"))
+        assert module["main"]("blocks-1") == 0
+    out = capsys.readouterr().out
+    assert "SOLVED_SATISFICING" in out and "validator: VALID" in out
