@@ -7,10 +7,11 @@ imports the module and takes the class from it. arrange-up's engine classes are 
 :mod:`arrange_up.up.engines`, which imports unified-planning; this module only names them
 (:data:`ENGINES`) and, through :func:`register`, tells unified-planning where they are.
 
-``import arrange_up`` calls :func:`register`. That must not import unified-planning, which costs
-about a second of start-up (figures and the commands that measure them: ``docs/design/up.md``),
-so when unified-planning has not loaded its factory yet, registration waits for it with an import
-hook. That hook is the one piece of import-system machinery in the package, and it lives here.
+``import arrange_up`` calls :func:`register`. That must not import unified-planning, whose
+start-up cost dwarfs the rest of ``import arrange_up`` (figures and the commands that measure
+them: ``docs/design/up.md``), so when unified-planning has not loaded its factory yet,
+registration waits for it with an import hook. That hook is the one piece of import-system
+machinery in the package, and it lives here.
 """
 
 from __future__ import annotations
