@@ -214,8 +214,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
                 "arrange-up ignores the heuristic argument: it searches belief space with its "
                 "own heuristics",
                 UserWarning,
-                # the frame that called _solve_with_params, as before the classes moved here
-                stacklevel=3,
+                stacklevel=3,  # unified-planning's solve(), which called _solve_with_params
             )
         stream = output_stream
 

@@ -138,6 +138,9 @@ _IMPORT_ORDERS = {
     ),
 }
 _SELECT_AND_SOLVE = """
+import sys
+from arrange_up.up.registration import _FactoryHook
+assert not any(isinstance(f, _FactoryHook) for f in sys.meta_path), 'the hook outlived its use'
 from arrange_up.io.domains import load
 from arrange_up.up.compile import to_up
 factory = get_environment().factory
