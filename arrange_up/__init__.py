@@ -2,9 +2,9 @@
 
 Importing this package is cheap: heavy libraries (unified-planning, pymunk, matplotlib) are
 imported only by the modules that need them. Importing it also registers arrange-up's engines
-with unified-planning (without importing unified-planning: the registration takes effect when
-unified-planning's engine factory loads), so ``OneshotPlanner(name="arrange-up")`` works in any
-program that has imported ``arrange_up``.
+with unified-planning (:mod:`arrange_up.up.registration`, without importing unified-planning),
+so ``OneshotPlanner(name="arrange-up")`` works in any program that has imported ``arrange_up``,
+before or after unified-planning.
 
 Entry points for library users::
 
@@ -16,9 +16,10 @@ Entry points for library users::
 
 from __future__ import annotations
 
+import importlib
 from typing import TYPE_CHECKING, Any
 
-from arrange_up.up.engines import register as _register_up_engines
+from arrange_up.up.registration import register as _register_up_engines
 
 __version__ = "0.1.0"
 __all__ = ["load", "plan", "to_up", "__version__"]
@@ -36,10 +37,9 @@ _LAZY = {
 
 
 def __getattr__(name: str) -> Any:
-    # The public functions live in modules with heavy imports; load them on first use.
+    # The public functions live in modules that import numpy or unified-planning (start-up
+    # cost in docs/design/up.md); ``import arrange_up`` must stay cheap, so load them on first use.
     if name in _LAZY:
-        import importlib
-
         module, attribute = _LAZY[name]
         value = getattr(importlib.import_module(module), attribute)
         globals()[name] = value

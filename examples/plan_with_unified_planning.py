@@ -6,23 +6,21 @@
 The problem is compiled to a UP model (real-valued place/push parameters, effects simulated by
 arrange-up's physics at the nominal, noise-free parameters), solved by the ``arrange-up``
 engine with the deterministic semantics, and the plan is checked by UP's own
-``SequentialPlanValidator``, which re-simulates every action.
+``SequentialPlanValidator``, which re-simulates every action. Importing ``arrange_up`` is what
+makes the ``arrange-up`` engine known to unified-planning, in either import order.
 """
 
 from __future__ import annotations
 
 import sys
 
-from arrange_up.io.domains import load
-from arrange_up.up.compile import to_up
-from arrange_up.up.engines import register
+from unified_planning.shortcuts import OneshotPlanner, PlanValidator
+
+import arrange_up
 
 
 def main(name: str = "blocks-2") -> int:
-    register()  # make the engine known to unified-planning (idempotent)
-    from unified_planning.shortcuts import OneshotPlanner, PlanValidator
-
-    problem = to_up(load(name))
+    problem = arrange_up.to_up(arrange_up.load(name))
     params = {"semantics": "deterministic", "seed": 0}
     with OneshotPlanner(name="arrange-up", params=params) as planner:
         result = planner.solve(problem, timeout=120)

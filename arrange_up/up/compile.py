@@ -49,6 +49,12 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+import unified_planning.model as m
+from unified_planning.environment import get_environment
+from unified_planning.plans import ActionInstance, SequentialPlan
+
+from arrange_up.belief.states import AngleFrame
+from arrange_up.io.pddl import problem_from_up
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Pick, Place, Push, nominal_initial_state
 from arrange_up.up.effects import (
@@ -96,9 +102,6 @@ def to_up(
     Raises ``ValueError`` for another semantics or for an object named like one of the model's
     types, fluents or actions (unified-planning refuses such a clash).
     """
-    import unified_planning.model as m
-    from unified_planning.environment import get_environment
-
     check_semantics(semantics)
     _check_names(problem)
     env = get_environment(environment)
@@ -188,8 +191,6 @@ def to_up(
         up.add_action(action)
 
     # -- initial state ---------------------------------------------------------------------
-    from arrange_up.belief.states import AngleFrame
-
     start = AngleFrame.of(problem).canonical(nominal_initial_state(problem))
     for name in start.names():
         up.set_initial_value(pose_fluents.on_table[name], True)
@@ -287,8 +288,6 @@ def from_up(up_problem: Any) -> ArrangementProblem:
                 "back: change the ArrangementProblem and compile it again"
             )
         return effect.problem
-    from arrange_up.io.pddl import problem_from_up
-
     return problem_from_up(up_problem)
 
 
@@ -298,8 +297,6 @@ def from_up(up_problem: Any) -> ArrangementProblem:
 def plan_to_up(up_problem: Any, actions: Sequence[Action]) -> Any:
     """A UP ``SequentialPlan`` of arrange-up actions (inches, radians) for a problem made by
     :func:`to_up`: real parameters are exact decimals (9 places), angles in degrees."""
-    from unified_planning.plans import ActionInstance, SequentialPlan
-
     em = up_problem.environment.expression_manager
     out = []
     for action in actions:

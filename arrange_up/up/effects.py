@@ -39,8 +39,13 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
-from arrange_up.model.problem import ArrangementProblem
+from unified_planning.exceptions import UPInvalidActionError
+from unified_planning.model import SimulatedEffect
+
+from arrange_up.belief.states import ParticleBelief, symmetry_period, wrap_angle
+from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action, Place, Push, WorldState
+from arrange_up.transitions import make_semantics
 
 __all__ = [
     "NOMINAL_SEMANTICS",
@@ -120,8 +125,6 @@ class PoseFluents:
         goal = problem.goal
         if goal.reference is None:
             return {}
-        from arrange_up.belief.states import symmetry_period, wrap_angle
-
         out: dict[Any, Fraction] = {}
         ref = world.pose(goal.reference)
         for part, (fx, fy, ftheta) in self.rel.items():
@@ -172,8 +175,6 @@ class TransitionEffect:
     # against another.
     def _key(self) -> tuple[Any, ...]:
         if self._content is None:
-            from arrange_up.model.problem import problem_hash
-
             self._content = problem_hash(self.problem)
         return (self.kind, self.semantics, self.written, self._content)
 
@@ -190,10 +191,6 @@ class TransitionEffect:
 
     # -- the effect ----------------------------------------------------------------------------
     def __call__(self, up_problem: Any, state: Any, params: Mapping[Any, Any]) -> list[Any]:
-        from unified_planning.exceptions import UPInvalidActionError
-
-        from arrange_up.belief.states import ParticleBelief
-
         values = {_name(p): v for p, v in params.items()}
         action = self.action(values)
         world = self.pose_fluents.read(self.problem, state)
@@ -242,8 +239,6 @@ class TransitionEffect:
 
     def model(self) -> Any:
         if self._model is None:
-            from arrange_up.transitions import make_semantics
-
             self._model = make_semantics("deterministic", self.problem, particles=1, seed=0)
         return self._model
 
@@ -270,8 +265,6 @@ def attach_effects(
 
     Raises ``ValueError`` for a semantics that cannot be compiled into effects.
     """
-    from unified_planning.model import SimulatedEffect
-
     check_semantics(semantics)
     rel = [f for triple in pose_fluents.rel.values() for f in triple]
 

@@ -1,4 +1,6 @@
-"""arrange-up's planner as a unified-planning engine: ``OneshotPlanner(name="arrange-up")``.
+"""arrange-up's unified-planning engines: the planner ``OneshotPlanner(name="arrange-up")``, the
+reliability validator ``PlanValidator(name="arrange-up-reliability")`` and the fixture-placement
+repairer ``PlanRepairer(name="arrange-up-fixtures")``.
 
     >>> from unified_planning.shortcuts import OneshotPlanner
     >>> from arrange_up.up.compile import to_up
@@ -9,10 +11,9 @@
     >>> result.status.name
     'SOLVED_SATISFICING'
 
-The engine converts the UP problem back to an
+**The planner** (:class:`ArrangeUpPlanner`) converts the UP problem back to an
 :class:`~arrange_up.model.problem.ArrangementProblem` (:func:`arrange_up.up.compile.from_up`:
-problems
-made by :func:`~arrange_up.up.compile.to_up`, and problems read by ``PDDLReader`` from
+problems made by :func:`~arrange_up.up.compile.to_up`, and problems read by ``PDDLReader`` from
 arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and returns a
 ``PlanGenerationResult`` with an honest status:
 
@@ -31,254 +32,280 @@ Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` 
 ``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000).
 Metrics hold the search statistics (expanded, generated, evaluated, pruned, elapsed, ...).
 
-**Registration** (:func:`register`). unified-planning finds engines only through its factory.
-Importing UP's engine machinery costs ~1.5 s (ConfigSpace, scipy), so :func:`register` never
-imports it: if UP's factory is already loaded it registers at once (idempotently), otherwise it
-installs an import hook that adds the engine to UP's default engine table as soon as UP loads
-its factory. Importing this module is as cheap; the engine classes themselves
-(:class:`ArrangeUpPlanner`, :class:`ArrangeUpReliability`) are built, importing UP, the first
-time they are asked for.
-
-**The reliability validator** ``PlanValidator(name="arrange-up-reliability")``
-(:class:`ArrangeUpReliability`) judges a plan by Monte Carlo rollouts under the problem's full
-noise (:func:`arrange_up.evaluation.evaluate.evaluate_plan`): it answers ``VALID`` only when every
-rollout reaches the goal, ``INVALID`` otherwise (with a log message breaking the failures down,
-and ``reason`` set from the most frequent failure: ``UNSATISFIED_GOALS`` when that is a missed
-goal, else ``INAPPLICABLE_ACTION`` naming the action that failed most often), ``UNKNOWN`` when
-the problem or the plan cannot be converted or the evaluation fails. Metrics: ``successes``,
-``trials``, ``rate``, ``interval`` (the 95% Wilson interval as ``[low, high]``),
-``interval_low``, ``interval_high``, ``seed``, ``elapsed`` and the failure counts per kind.
-Parameters: ``rollouts`` (1000), ``seed`` (0), ``workers`` (``None``: all cores), ``backend``
-(``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address).
+**The reliability validator** (:class:`ArrangeUpReliability`) judges a plan by Monte Carlo
+rollouts under the problem's full noise (:func:`arrange_up.evaluation.evaluate.evaluate_plan`):
+it answers ``VALID`` only when every rollout reaches the goal, ``INVALID`` otherwise (with a log
+message breaking the failures down, and ``reason`` set from the most frequent failure:
+``UNSATISFIED_GOALS`` when that is a missed goal, else ``INAPPLICABLE_ACTION`` naming the action
+that failed most often), ``UNKNOWN`` when the problem or the plan cannot be converted or the
+evaluation fails. Metrics: ``successes``, ``trials``, ``rate``, ``interval`` (the 95% Wilson
+interval as ``[low, high]``), ``interval_low``, ``interval_high``, ``seed``, ``elapsed`` and the
+failure counts per kind. Parameters: ``rollouts`` (1000), ``seed`` (0), ``workers`` (``None``:
+all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address).
 
     >>> from unified_planning.shortcuts import PlanValidator
     >>> with PlanValidator(name="arrange-up-reliability", params={"rollouts": 100}) as v:
     ...     check = v.validate(problem, result.plan)
     >>> check.metrics["successes"], check.metrics["interval"]     # doctest: +SKIP
     ('100', '[0.963, 1]')
+
+**The repairer** (:class:`ArrangeUpFixtureRepairer`): see its docstring.
+
+**Registration.** The classes are found by unified-planning's factory through their module and
+class names (:data:`arrange_up.up.registration.ENGINES`); ``import arrange_up`` registers them
+without importing this module or unified-planning (:mod:`arrange_up.up.registration`).
+:func:`register` is re-exported here for existing callers.
 """
 
 from __future__ import annotations
 
-import functools
-import sys
+import time
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import IO, Any
 
-# Only ``sys`` at import time: this module is imported when arrange-up is, and must stay cheap
-# (``typing``, ``functools`` and ``warnings`` alone add ~10 ms to a bare interpreter).
-TYPE_CHECKING = False
-if TYPE_CHECKING:
-    from typing import Any
-
-# ArrangeUpPlanner and ArrangeUpReliability are also public; they are built on first access
-# (see ``__getattr__``)
-__all__ = ["ENGINE_CLASS", "ENGINE_NAME", "VALIDATOR_CLASS", "VALIDATOR_NAME", "register"]
-
-ENGINE_NAME = "arrange-up"
-ENGINE_CLASS = "ArrangeUpPlanner"
-VALIDATOR_NAME = "arrange-up-reliability"
-VALIDATOR_CLASS = "ArrangeUpReliability"
-#: Every engine the package registers: (name in UP's factory, class name in this module).
-ENGINES: tuple[tuple[str, str], ...] = (
-    (ENGINE_NAME, ENGINE_CLASS),
-    (VALIDATOR_NAME, VALIDATOR_CLASS),
-    ("arrange-up-fixtures", "ArrangeUpFixtureRepairer"),
+from unified_planning.engines import (
+    Engine,
+    LogLevel,
+    LogMessage,
+    PlanGenerationResult,
+    ValidationResult,
 )
-_FACTORY_MODULE = "unified_planning.engines.factory"
+from unified_planning.engines import PlanGenerationResultStatus as Status
+from unified_planning.engines.mixins import (
+    OneshotPlannerMixin,
+    PlanRepairerMixin,
+    PlanValidatorMixin,
+)
+from unified_planning.engines.results import FailedValidationReason, ValidationResultStatus
+from unified_planning.model import AbstractProblem, ProblemKind
+from unified_planning.model.state import State
+from unified_planning.plans import Plan, PlanKind
+
+from arrange_up.evaluation.evaluate import GOAL_MISSED, evaluate_plan
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action, Push
+from arrange_up.planning import planner
+from arrange_up.repair.fixture_repair import repair_plan
+from arrange_up.transitions import available
+from arrange_up.up.compile import from_up, made_by_to_up, plan_from_up, plan_to_up, to_up
+from arrange_up.up.registration import (
+    ENGINE_CLASS,
+    ENGINE_NAME,
+    ENGINES,
+    REPAIRER_CLASS,
+    REPAIRER_NAME,
+    VALIDATOR_CLASS,
+    VALIDATOR_NAME,
+    register,
+)
+
+__all__ = [
+    "ENGINES",
+    "ENGINE_CLASS",
+    "ENGINE_NAME",
+    "REPAIRER_CLASS",
+    "REPAIRER_NAME",
+    "VALIDATOR_CLASS",
+    "VALIDATOR_NAME",
+    "ArrangeUpFixtureRepairer",
+    "ArrangeUpPlanner",
+    "ArrangeUpReliability",
+    "register",
+]
+
+
+def _supported_kind() -> ProblemKind:
+    kind = ProblemKind(version=2)
+    kind.set_problem_class("ACTION_BASED")
+    kind.set_problem_type("SIMPLE_NUMERIC_PLANNING")
+    kind.set_typing("FLAT_TYPING")
+    kind.set_typing("HIERARCHICAL_TYPING")
+    kind.set_conditions_kind("NEGATIVE_CONDITIONS")
+    kind.set_conditions_kind("EQUALITIES")
+    kind.set_parameters("REAL_ACTION_PARAMETERS")
+    kind.set_fluents_type("REAL_FLUENTS")
+    kind.set_simulated_entities("SIMULATED_EFFECTS")
+    kind.set_initial_state("UNDEFINED_INITIAL_NUMERIC")
+    return kind
+
+
+#: The problem kind every arrange-up engine supports: the kind of what ``to_up`` makes.
+SUPPORTED_KIND = _supported_kind()
+
+
+class _ArrangeUpEngine(Engine):
+    """The shared base of arrange-up's engines: the engine's name from the class attribute
+    ``_NAME``, and the problem kinds and plan kinds every arrange-up engine supports."""
+
+    _NAME = ""
+
+    @property
+    def name(self) -> str:
+        return self._NAME
+
+    @staticmethod
+    def supported_kind() -> ProblemKind:
+        return SUPPORTED_KIND
+
+    @staticmethod
+    def supports(problem_kind: ProblemKind) -> bool:
+        return bool(problem_kind <= SUPPORTED_KIND)
+
+    @staticmethod
+    def supports_plan(plan_kind: PlanKind) -> bool:
+        return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
 
 
 # ---------------------------------------------------------------------------------------------
-# registration (standard library only)
+# the planner
 # ---------------------------------------------------------------------------------------------
-def register(environment: Any = None) -> None:
-    """Make arrange-up's engines (the ``arrange-up`` planner and the ``arrange-up-reliability``
-    validator) known to unified-planning; cheap and idempotent.
+class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
+    """Conformant belief-space planning for arrange-up problems (see the module doc)."""
 
-    * UP's factory module already imported: add the engines to its default engine table (for
-      environments created later) and to the factory of ``environment`` or of UP's global
-      environment if it exists.
-    * Otherwise: install an import hook that adds the engines to the default table when UP
-      imports its factory, so the global environment has it from the start. Nothing of UP is
-      imported here.
-    """
-    module = sys.modules.get(_FACTORY_MODULE)
-    if module is None and environment is None:
-        if not any(isinstance(finder, _FactoryHook) for finder in sys.meta_path):
-            sys.meta_path.insert(0, _FactoryHook())
-        return
-    if module is not None:
-        _add_to_defaults(module)
-    if environment is None:
-        env_module = sys.modules.get("unified_planning.environment")
-        environment = getattr(env_module, "GLOBAL_ENVIRONMENT", None)
-    if environment is not None:
-        for name, class_name in ENGINES:
-            if name not in environment.factory.engines:
-                environment.factory.add_engine(name, __name__, class_name)
+    _NAME = ENGINE_NAME
 
+    def __init__(
+        self,
+        semantics: str = "particles",
+        particles: int = 50,
+        seed: int = 0,
+        max_nodes: int | None = None,
+    ) -> None:
+        Engine.__init__(self)
+        OneshotPlannerMixin.__init__(self)
+        _check_params(semantics, particles, seed, max_nodes)
+        self._semantics = semantics
+        self._particles = particles
+        self._seed = seed
+        self._max_nodes = max_nodes
 
-def _add_to_defaults(factory_module: Any) -> None:
-    defaults = getattr(factory_module, "DEFAULT_ENGINES", None)
-    preference = getattr(factory_module, "DEFAULT_ENGINES_PREFERENCE_LIST", None)
-    for name, class_name in ENGINES:
-        if isinstance(defaults, dict):
-            defaults.setdefault(name, (__name__, class_name))
-        if isinstance(preference, list) and name not in preference:
-            preference.append(name)
+    def _solve_with_params(
+        self,
+        problem: AbstractProblem,
+        heuristic: Callable[[State], float | None] | None = None,
+        timeout: float | None = None,
+        output_stream: IO[str] | None = None,
+        warm_start_plan: Plan | None = None,
+        **kwargs: Any,
+    ) -> PlanGenerationResult:
+        if warm_start_plan is not None:
+            warnings.warn("arrange-up ignores warm_start_plan", UserWarning, stacklevel=3)
+        if kwargs:
+            warnings.warn(
+                f"arrange-up ignores the solve() arguments {', '.join(sorted(kwargs))}; "
+                "give engine parameters through OneshotPlanner(params={...})",
+                UserWarning,
+                stacklevel=3,
+            )
+        return self._solve(problem, heuristic, timeout, output_stream)
 
+    def _solve(
+        self,
+        problem: AbstractProblem,
+        heuristic: Callable[[State], float | None] | None = None,
+        timeout: float | None = None,
+        output_stream: IO[str] | None = None,
+    ) -> PlanGenerationResult:
+        started = time.monotonic()
+        if heuristic is not None:
+            warnings.warn(
+                "arrange-up ignores the heuristic argument: it searches belief space with its "
+                "own heuristics",
+                UserWarning,
+                stacklevel=3,  # unified-planning's solve(), which called _solve_with_params
+            )
+        stream = output_stream
 
-class _FactoryHook:
-    """A meta path finder that finds nothing itself; it wraps the loader of UP's factory module
-    so that :func:`_add_to_defaults` runs right after the module is executed. (Not derived from
-    ``importlib.abc`` classes: importing ``importlib.abc`` alone costs ~20 ms.)"""
+        def result(
+            status: Status,
+            plan: Plan | None = None,
+            logs: Sequence[LogMessage] = (),
+            metrics: dict[str, str] | None = None,
+        ) -> PlanGenerationResult:
+            return PlanGenerationResult(
+                status, plan, ENGINE_NAME, metrics=metrics, log_messages=list(logs) or None
+            )
 
-    def find_spec(self, fullname: str, path: Any, target: Any = None) -> Any:
-        if fullname != _FACTORY_MODULE:
-            return None
-        for finder in sys.meta_path:
-            if finder is self or not hasattr(finder, "find_spec"):
-                continue
-            spec = finder.find_spec(fullname, path, target)
-            if spec is not None:
-                break
-        else:
-            return None
-        if spec.loader is not None and hasattr(spec.loader, "exec_module"):
-            spec.loader = _PatchingLoader(spec.loader, self)
-        return spec
+        try:
+            arrangement = from_up(problem)
+        except ValueError as error:  # ProblemFormatError is a ValueError
+            return result(
+                Status.UNSUPPORTED_PROBLEM,
+                logs=[LogMessage(LogLevel.ERROR, f"not an arrange-up problem: {error}")],
+            )
 
+        deadline = None if timeout is None else started + max(0.0, float(timeout))
 
-class _PatchingLoader:
-    def __init__(self, loader: Any, hook: _FactoryHook) -> None:
-        self._loader = loader
-        self._hook = hook
+        def out_of_time() -> bool:
+            return deadline is not None and time.monotonic() >= deadline
 
-    def create_module(self, spec: Any) -> Any:
-        return self._loader.create_module(spec)
-
-    def exec_module(self, module: Any) -> None:
-        self._loader.exec_module(module)
-        if self._hook in sys.meta_path:
-            sys.meta_path.remove(self._hook)
-        _add_to_defaults(module)
-
-    def __getattr__(self, name: str) -> Any:  # get_source, get_filename, ... of the real loader
-        return getattr(self._loader, name)
-
-
-def __getattr__(name: str) -> Any:  # PEP 562: the engine classes are built on first use
-    if name == ENGINE_CLASS:
-        return _engine_class()
-    if name == VALIDATOR_CLASS:
-        return _validator_class()
-    if name == "ArrangeUpFixtureRepairer":
-        return _repairer_class()
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-# ---------------------------------------------------------------------------------------------
-# the engine (imports unified-planning)
-# ---------------------------------------------------------------------------------------------
-_CACHE: dict[str, Any] = {}
-
-
-def _engine_base() -> type:
-    """The shared base of arrange-up's engines (built on first use: it imports
-    unified-planning): the engine's name from the class attribute ``_NAME``, and the problem
-    kinds and plan kinds every arrange-up engine supports."""
-    if "base" not in _CACHE:
-        from unified_planning.engines import Engine
-
-        class _ArrangeUpEngine(Engine):
-            _NAME = ""
-
-            @property
-            def name(self) -> str:
-                return self._NAME
-
-            @staticmethod
-            def supported_kind() -> Any:
-                return _supported_kind()
-
-            @staticmethod
-            def supports(problem_kind: Any) -> bool:
-                return bool(problem_kind <= _supported_kind())
-
-            @staticmethod
-            def supports_plan(plan_kind: Any) -> bool:
-                from unified_planning.plans import PlanKind
-
-                return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
-
-        _CACHE["base"] = _ArrangeUpEngine
-    return _CACHE["base"]
-
-
-@functools.cache
-def _engine_class() -> type:
-    import warnings
-
-    from unified_planning.engines import Engine
-    from unified_planning.engines.mixins import OneshotPlannerMixin
-
-    class ArrangeUpPlanner(_engine_base(), OneshotPlannerMixin):  # type: ignore[misc]
-        """Conformant belief-space planning for arrange-up problems (see the module doc)."""
-
-        _NAME = ENGINE_NAME
-
-        def __init__(
-            self,
-            semantics: str = "particles",
-            particles: int = 50,
-            seed: int = 0,
-            max_nodes: int | None = None,
-        ) -> None:
-            Engine.__init__(self)
-            OneshotPlannerMixin.__init__(self)
-            _check_params(semantics, particles, seed, max_nodes)
-            self._semantics = semantics
-            self._particles = particles
-            self._seed = seed
-            self._max_nodes = max_nodes
-
-        def _solve_with_params(
-            self,
-            problem: Any,
-            heuristic: Any = None,
-            timeout: float | None = None,
-            output_stream: Any = None,
-            warm_start_plan: Any = None,
-            **kwargs: Any,
-        ) -> Any:
-            if warm_start_plan is not None:
-                warnings.warn("arrange-up ignores warm_start_plan", UserWarning, stacklevel=3)
-            if kwargs:
-                warnings.warn(
-                    f"arrange-up ignores the solve() arguments {', '.join(sorted(kwargs))}; "
-                    "give engine parameters through OneshotPlanner(params={...})",
-                    UserWarning,
-                    stacklevel=3,
+        def progress(stats: dict[str, Any]) -> None:
+            if stream is not None:
+                stream.write(
+                    "arrange-up: " + " ".join(f"{k}={_short(v)}" for k, v in stats.items()) + "\n"
                 )
-            return self._solve(problem, heuristic, timeout, output_stream)
 
-        def _solve(
-            self,
-            problem: Any,
-            heuristic: Any = None,
-            timeout: float | None = None,
-            output_stream: Any = None,
-        ) -> Any:
-            return _solve(self, problem, heuristic, timeout, output_stream)
+        try:
+            outcome = planner.plan(
+                arrangement,
+                semantics=self._semantics,
+                particles=self._particles,
+                seed=self._seed,
+                max_nodes=self._max_nodes,
+                timeout=None if deadline is None else max(0.0, deadline - time.monotonic()),
+                progress=progress,
+                should_stop=out_of_time,
+            )
+        except Exception as error:  # the engine must answer, not raise
+            return result(
+                Status.INTERNAL_ERROR,
+                logs=[
+                    LogMessage(
+                        LogLevel.ERROR, f"arrange-up failed: {type(error).__name__}: {error}"
+                    )
+                ],
+            )
 
-    ArrangeUpPlanner.__module__ = __name__
-    ArrangeUpPlanner.__qualname__ = (
-        ENGINE_CLASS  # picklable as arrange_up.up.engines.ArrangeUpPlanner
-    )
-    return ArrangeUpPlanner
+        metrics = {key: _short(value) for key, value in outcome.stats.items()}
+        metrics.update(
+            status=outcome.status,
+            semantics=outcome.semantics,
+            particles=str(outcome.particles),
+            seed=str(outcome.seed),
+        )
+        limit = outcome.stats.get("max_nodes")
+        if outcome.status == planner.SOLVED and outcome.actions is not None:
+            plan, logs = _plan_to_up(problem, arrangement, outcome.actions)
+            return result(Status.SOLVED_SATISFICING, plan, logs, metrics)
+        if outcome.status == planner.TIMEOUT or (
+            outcome.status == planner.CANCELLED and out_of_time()
+        ):
+            message = f"timeout of {timeout} s reached without a plan"
+            return result(Status.TIMEOUT, None, [LogMessage(LogLevel.INFO, message)], metrics)
+        if outcome.status == planner.NODE_LIMIT:
+            message = (
+                f"node limit of {limit} expanded nodes reached without a plan; the search is "
+                "incomplete, so the problem is not proven unsolvable"
+            )
+            return result(
+                Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
+            )
+        if outcome.status == planner.UNSOLVABLE:
+            message = (
+                "the search space was exhausted without a plan; the action generators and "
+                "dominance pruning make the search incomplete, so the problem is not proven "
+                "unsolvable"
+            )
+            return result(
+                Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
+            )
+        message = f"the planner stopped with status {outcome.status!r}"
+        return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)
 
 
 def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any) -> None:
-    from arrange_up.transitions import available
-
     if semantics not in available():
         raise ValueError(
             f"arrange-up: unknown semantics {semantics!r}; expected one of {', '.join(available())}"
@@ -293,131 +320,12 @@ def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any) -> 
         raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
 
 
-def _supported_kind() -> Any:
-    if "kind" in _CACHE:
-        return _CACHE["kind"]
-    from unified_planning.model import ProblemKind
-
-    kind = ProblemKind(version=2)
-    kind.set_problem_class("ACTION_BASED")
-    kind.set_problem_type("SIMPLE_NUMERIC_PLANNING")
-    kind.set_typing("FLAT_TYPING")
-    kind.set_typing("HIERARCHICAL_TYPING")
-    kind.set_conditions_kind("NEGATIVE_CONDITIONS")
-    kind.set_conditions_kind("EQUALITIES")
-    kind.set_parameters("REAL_ACTION_PARAMETERS")
-    kind.set_fluents_type("REAL_FLUENTS")
-    kind.set_simulated_entities("SIMULATED_EFFECTS")
-    kind.set_initial_state("UNDEFINED_INITIAL_NUMERIC")
-    _CACHE["kind"] = kind
-    return kind
-
-
-def _solve(engine: Any, problem: Any, heuristic: Any, timeout: float | None, stream: Any) -> Any:
-    import time
-    import warnings
-
-    from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
-    from unified_planning.engines import PlanGenerationResultStatus as Status
-
-    from arrange_up.planning import planner
-    from arrange_up.up.compile import from_up
-
-    started = time.monotonic()
-    if heuristic is not None:
-        warnings.warn(
-            "arrange-up ignores the heuristic argument: it searches belief space with its own "
-            "heuristics",
-            UserWarning,
-            stacklevel=4,
-        )
-
-    def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
-        return PlanGenerationResult(
-            status, plan, ENGINE_NAME, metrics=metrics, log_messages=list(logs) or None
-        )
-
-    try:
-        arrangement = from_up(problem)
-    except ValueError as error:  # ProblemFormatError is a ValueError
-        return result(
-            Status.UNSUPPORTED_PROBLEM,
-            logs=[LogMessage(LogLevel.ERROR, f"not an arrange-up problem: {error}")],
-        )
-
-    deadline = None if timeout is None else started + max(0.0, float(timeout))
-
-    def out_of_time() -> bool:
-        return deadline is not None and time.monotonic() >= deadline
-
-    def progress(stats: dict[str, Any]) -> None:
-        if stream is not None:
-            stream.write(
-                "arrange-up: " + " ".join(f"{k}={_short(v)}" for k, v in stats.items()) + "\n"
-            )
-
-    try:
-        outcome = planner.plan(
-            arrangement,
-            semantics=engine._semantics,
-            particles=engine._particles,
-            seed=engine._seed,
-            max_nodes=engine._max_nodes,
-            timeout=None if deadline is None else max(0.0, deadline - time.monotonic()),
-            progress=progress,
-            should_stop=out_of_time,
-        )
-    except Exception as error:  # the engine must answer, not raise
-        return result(
-            Status.INTERNAL_ERROR,
-            logs=[
-                LogMessage(LogLevel.ERROR, f"arrange-up failed: {type(error).__name__}: {error}")
-            ],
-        )
-
-    metrics = {key: _short(value) for key, value in outcome.stats.items()}
-    metrics.update(
-        status=outcome.status,
-        semantics=outcome.semantics,
-        particles=str(outcome.particles),
-        seed=str(outcome.seed),
-    )
-    limit = outcome.stats.get("max_nodes")
-    if outcome.status == planner.SOLVED and outcome.actions is not None:
-        plan, logs = _plan_to_up(problem, arrangement, outcome.actions)
-        return result(Status.SOLVED_SATISFICING, plan, logs, metrics)
-    if outcome.status == planner.TIMEOUT or (outcome.status == planner.CANCELLED and out_of_time()):
-        message = f"timeout of {timeout} s reached without a plan"
-        return result(Status.TIMEOUT, None, [LogMessage(LogLevel.INFO, message)], metrics)
-    if outcome.status == planner.NODE_LIMIT:
-        message = (
-            f"node limit of {limit} expanded nodes reached without a plan; the search is "
-            "incomplete, so the problem is not proven unsolvable"
-        )
-        return result(
-            Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
-        )
-    if outcome.status == planner.UNSOLVABLE:
-        message = (
-            "the search space was exhausted without a plan; the action generators and "
-            "dominance pruning make the search incomplete, so the problem is not proven "
-            "unsolvable"
-        )
-        return result(
-            Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
-        )
-    message = f"the planner stopped with status {outcome.status!r}"
-    return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)
-
-
-def _plan_to_up(problem: Any, arrangement: Any, actions: Any) -> tuple[Any, list[Any]]:
+def _plan_to_up(
+    problem: AbstractProblem, arrangement: ArrangementProblem, actions: Sequence[Action]
+) -> tuple[Plan, list[LogMessage]]:
     """The unified-planning plan of ``actions`` for ``problem``, and the log messages to return
     with it. A problem that did not come from :func:`arrange_up.up.compile.to_up` (one read from
     PDDL) has no actions with real parameters, so the plan is one of ``to_up(arrangement)``."""
-    from unified_planning.engines import LogLevel, LogMessage
-
-    from arrange_up.up.compile import made_by_to_up, plan_to_up, to_up
-
     logs = []
     target = problem
     if not made_by_to_up(problem):
@@ -432,12 +340,8 @@ def _plan_to_up(problem: Any, arrangement: Any, actions: Any) -> tuple[Any, list
     return plan_to_up(target, [_plain(a) for a in actions]), logs
 
 
-def _plain(action: Any) -> Any:
+def _plain(action: Action) -> Action:
     """The action with plain Python floats (the planner may hand out numpy scalars)."""
-    from dataclasses import replace
-
-    from arrange_up.model.world import Push
-
     pose = tuple(float(v) for v in getattr(action, "pose", ()))
     if isinstance(action, Push):
         return replace(action, pose=pose, distance=float(action.distance))
@@ -452,15 +356,12 @@ def _short(value: Any) -> str:
     return str(value)
 
 
-# ---------------------------------------------------------------------------------------------
-# the reliability validator (imports unified-planning)
-# ---------------------------------------------------------------------------------------------
-def _read_problem_and_plan(problem: Any, plan: Any) -> tuple[Any, Any] | str:
+def _read_problem_and_plan(
+    problem: AbstractProblem, plan: Plan
+) -> tuple[ArrangementProblem, tuple[Action, ...]] | str:
     """The arrange-up problem and action list of a unified-planning ``problem`` and ``plan``,
     or the message that says which of the two is not one (the validator and the repairer
     answer with it; engines never raise)."""
-    from arrange_up.up.compile import from_up, plan_from_up
-
     try:
         arrangement = from_up(problem)
     except ValueError as error:  # ProblemFormatError is a ValueError
@@ -472,52 +373,132 @@ def _read_problem_and_plan(problem: Any, plan: Any) -> tuple[Any, Any] | str:
     return arrangement, actions
 
 
-@functools.cache
-def _validator_class() -> type:
-    from unified_planning.engines import Engine
-    from unified_planning.engines.mixins import PlanValidatorMixin
+def _positive(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 1
 
-    class ArrangeUpReliability(_engine_base(), PlanValidatorMixin):  # type: ignore[misc]
-        """Monte Carlo reliability of a plan under the problem's noise (see the module doc)."""
 
-        _NAME = VALIDATOR_NAME
+# ---------------------------------------------------------------------------------------------
+# the reliability validator
+# ---------------------------------------------------------------------------------------------
+class ArrangeUpReliability(_ArrangeUpEngine, PlanValidatorMixin):
+    """Monte Carlo reliability of a plan under the problem's noise (see the module doc)."""
 
-        def __init__(
-            self,
-            rollouts: int = 1000,
-            seed: int = 0,
-            workers: int | None = None,
-            backend: str = "local",
-            scheduler: str | None = None,
-        ) -> None:
-            Engine.__init__(self)
-            PlanValidatorMixin.__init__(self)
-            _check_validator_params(rollouts, seed, workers, backend, scheduler)
-            self._rollouts = rollouts
-            self._seed = seed
-            self._workers = workers
-            self._backend = backend
-            self._scheduler = scheduler
+    _NAME = VALIDATOR_NAME
 
-        def _validate(self, problem: Any, plan: Any) -> Any:
-            return _validate(self, problem, plan)
+    def __init__(
+        self,
+        rollouts: int = 1000,
+        seed: int = 0,
+        workers: int | None = None,
+        backend: str = "local",
+        scheduler: str | None = None,
+    ) -> None:
+        Engine.__init__(self)
+        PlanValidatorMixin.__init__(self)
+        _check_validator_params(rollouts, seed, workers, backend, scheduler)
+        self._rollouts = rollouts
+        self._seed = seed
+        self._workers = workers
+        self._backend = backend
+        self._scheduler = scheduler
 
-    ArrangeUpReliability.__module__ = __name__
-    ArrangeUpReliability.__qualname__ = VALIDATOR_CLASS
-    return ArrangeUpReliability
+    def _validate(self, problem: AbstractProblem, plan: Plan) -> ValidationResult:
+        def unknown(message: str) -> ValidationResult:
+            return ValidationResult(
+                ValidationResultStatus.UNKNOWN,
+                VALIDATOR_NAME,
+                log_messages=[LogMessage(LogLevel.ERROR, message)],
+            )
+
+        read = _read_problem_and_plan(problem, plan)
+        if isinstance(read, str):
+            return unknown(read)
+        arrangement, actions = read
+        try:
+            outcome = evaluate_plan(
+                arrangement,
+                actions,
+                rollouts=self._rollouts,
+                seed=self._seed,
+                workers=self._workers,
+                backend=self._backend,
+                scheduler=self._scheduler,
+            )
+        except Exception as error:  # the engine must answer, not raise
+            return unknown(f"the evaluation failed: {type(error).__name__}: {error}")
+
+        failures = outcome.failures
+        low, high = outcome.interval
+        metrics = {
+            "successes": str(outcome.successes),
+            "trials": str(outcome.trials),
+            "rate": f"{outcome.rate:.6g}",
+            "interval": f"[{low:.6g}, {high:.6g}]",
+            "interval_low": f"{low:.6g}",
+            "interval_high": f"{high:.6g}",
+            "seed": str(outcome.seed),
+            "elapsed": f"{outcome.elapsed:.6g}",
+            "goal_missed": str(failures.goal_missed),
+            "action_failed": str(failures.action_failed),
+            "not_at_rest": str(failures.not_at_rest),
+            "off_table": str(failures.off_table),
+        }
+        summary = (
+            f"{outcome.successes} of {outcome.trials} rollouts reached the goal (rate "
+            f"{outcome.rate:.4g}, 95% Wilson interval [{low:.4g}, {high:.4g}], "
+            f"seed {outcome.seed})"
+        )
+        if outcome.successes == outcome.trials:
+            return ValidationResult(
+                ValidationResultStatus.VALID,
+                VALIDATOR_NAME,
+                log_messages=[LogMessage(LogLevel.INFO, summary)],
+                metrics=metrics,
+            )
+        # the most frequent failure decides UP's reason
+        per_action: dict[int, int] = {}
+        for entry in (
+            *failures.action_failures,
+            *failures.not_at_rest_actions,
+            *failures.off_table_actions,
+        ):
+            per_action[entry.action] = per_action.get(entry.action, 0) + entry.rollouts
+        worst_action = max(per_action, key=lambda a: (per_action[a], -a), default=None)
+        lines = [summary + "; failures:"]
+        if failures.goal_missed:
+            parts = ", ".join(f"{m.part} {m.dimension} {m.rollouts}" for m in failures.goal_misses)
+            lines.append(f"  {GOAL_MISSED}: {failures.goal_missed} ({parts})")
+        for entry in failures.action_failures:
+            lines.append(f"  action {entry.action} failed in {entry.rollouts}: {entry.reason}")
+        for entry in failures.not_at_rest_actions:
+            lines.append(f"  action {entry.action} did not come to rest in {entry.rollouts}")
+        for entry in failures.off_table_actions:
+            lines.append(
+                f"  action {entry.action} put {entry.object} off the table in {entry.rollouts}"
+            )
+        if worst_action is None or failures.goal_missed >= per_action[worst_action]:
+            reason, inapplicable = FailedValidationReason.UNSATISFIED_GOALS, None
+        else:
+            reason = FailedValidationReason.INAPPLICABLE_ACTION
+            inapplicable = plan.actions[worst_action]
+        return ValidationResult(
+            ValidationResultStatus.INVALID,
+            VALIDATOR_NAME,
+            log_messages=[LogMessage(LogLevel.INFO, "\n".join(lines))],
+            reason=reason,
+            inapplicable_action=inapplicable,
+            metrics=metrics,
+        )
 
 
 def _check_validator_params(
     rollouts: Any, seed: Any, workers: Any, backend: Any, scheduler: Any
 ) -> None:
-    def positive(value: Any) -> bool:
-        return isinstance(value, int) and not isinstance(value, bool) and value >= 1
-
-    if not positive(rollouts):
+    if not _positive(rollouts):
         raise ValueError(f"{VALIDATOR_NAME}: rollouts must be a positive integer, got {rollouts!r}")
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise ValueError(f"{VALIDATOR_NAME}: seed must be a non-negative integer, got {seed!r}")
-    if workers is not None and not positive(workers):
+    if workers is not None and not _positive(workers):
         raise ValueError(f"{VALIDATOR_NAME}: workers must be a positive integer, got {workers!r}")
     if backend not in ("local", "dask"):
         raise ValueError(f"{VALIDATOR_NAME}: backend must be 'local' or 'dask', got {backend!r}")
@@ -525,158 +506,112 @@ def _check_validator_params(
         raise ValueError(f"{VALIDATOR_NAME}: a scheduler address needs backend='dask'")
 
 
-def _validate(engine: Any, problem: Any, plan: Any) -> Any:
-    from unified_planning.engines import LogLevel, LogMessage, ValidationResult
-    from unified_planning.engines.results import FailedValidationReason, ValidationResultStatus
-
-    from arrange_up.evaluation.evaluate import GOAL_MISSED, evaluate_plan
-
-    def unknown(message: str) -> Any:
-        return ValidationResult(
-            ValidationResultStatus.UNKNOWN,
-            VALIDATOR_NAME,
-            log_messages=[LogMessage(LogLevel.ERROR, message)],
-        )
-
-    read = _read_problem_and_plan(problem, plan)
-    if isinstance(read, str):
-        return unknown(read)
-    arrangement, actions = read
-    try:
-        outcome = evaluate_plan(
-            arrangement,
-            actions,
-            rollouts=engine._rollouts,
-            seed=engine._seed,
-            workers=engine._workers,
-            backend=engine._backend,
-            scheduler=engine._scheduler,
-        )
-    except Exception as error:  # the engine must answer, not raise
-        return unknown(f"the evaluation failed: {type(error).__name__}: {error}")
-
-    failures = outcome.failures
-    low, high = outcome.interval
-    metrics = {
-        "successes": str(outcome.successes),
-        "trials": str(outcome.trials),
-        "rate": f"{outcome.rate:.6g}",
-        "interval": f"[{low:.6g}, {high:.6g}]",
-        "interval_low": f"{low:.6g}",
-        "interval_high": f"{high:.6g}",
-        "seed": str(outcome.seed),
-        "elapsed": f"{outcome.elapsed:.6g}",
-        "goal_missed": str(failures.goal_missed),
-        "action_failed": str(failures.action_failed),
-        "not_at_rest": str(failures.not_at_rest),
-        "off_table": str(failures.off_table),
-    }
-    summary = (
-        f"{outcome.successes} of {outcome.trials} rollouts reached the goal (rate "
-        f"{outcome.rate:.4g}, 95% Wilson interval [{low:.4g}, {high:.4g}], seed {outcome.seed})"
-    )
-    if outcome.successes == outcome.trials:
-        return ValidationResult(
-            ValidationResultStatus.VALID,
-            VALIDATOR_NAME,
-            log_messages=[LogMessage(LogLevel.INFO, summary)],
-            metrics=metrics,
-        )
-    # the most frequent failure decides UP's reason
-    per_action: dict[int, int] = {}
-    for entry in (
-        *failures.action_failures,
-        *failures.not_at_rest_actions,
-        *failures.off_table_actions,
-    ):
-        per_action[entry.action] = per_action.get(entry.action, 0) + entry.rollouts
-    worst_action = max(per_action, key=lambda a: (per_action[a], -a), default=None)
-    lines = [summary + "; failures:"]
-    if failures.goal_missed:
-        parts = ", ".join(f"{m.part} {m.dimension} {m.rollouts}" for m in failures.goal_misses)
-        lines.append(f"  {GOAL_MISSED}: {failures.goal_missed} ({parts})")
-    for entry in failures.action_failures:
-        lines.append(f"  action {entry.action} failed in {entry.rollouts}: {entry.reason}")
-    for entry in failures.not_at_rest_actions:
-        lines.append(f"  action {entry.action} did not come to rest in {entry.rollouts}")
-    for entry in failures.off_table_actions:
-        lines.append(
-            f"  action {entry.action} put {entry.object} off the table in {entry.rollouts}"
-        )
-    if worst_action is None or failures.goal_missed >= per_action[worst_action]:
-        reason, inapplicable = FailedValidationReason.UNSATISFIED_GOALS, None
-    else:
-        reason = FailedValidationReason.INAPPLICABLE_ACTION
-        inapplicable = plan.actions[worst_action]
-    return ValidationResult(
-        ValidationResultStatus.INVALID,
-        VALIDATOR_NAME,
-        log_messages=[LogMessage(LogLevel.INFO, "\n".join(lines))],
-        reason=reason,
-        inapplicable_action=inapplicable,
-        metrics=metrics,
-    )
-
-
 # ---------------------------------------------------------------------------------------------
-# the fixture-placement plan repairer (imports unified-planning)
+# the fixture-placement plan repairer
 # ---------------------------------------------------------------------------------------------
-REPAIRER_NAME = "arrange-up-fixtures"
-REPAIRER_CLASS = "ArrangeUpFixtureRepairer"
+class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
+    """Fixture-placement plan repair (thesis ch. 4,
+    :func:`arrange_up.repair.fixture_repair.repair_plan`):
+    ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
 
+    Parameters: ``particles`` (150), ``seed`` (0), ``method`` (``"enhanced"`` or
+    ``"naive"``), ``workers`` (1). The plan is the nominal plan to repair (a
+    ``SequentialPlan`` of place/push/pick); the result is a ``PlanGenerationResult``:
+    ``SOLVED_SATISFICING`` with the repaired plan, ``UNSOLVABLE_INCOMPLETELY`` when a step
+    could not be repaired (the log message says which and why; the repair is greedy, so
+    nothing is proven), ``UNSUPPORTED_PROBLEM`` when the problem or plan is not
+    arrange-up's (or the plan fails in the deterministic semantics), ``INTERNAL_ERROR`` when
+    the repair raised. Metrics: ``status``, ``elapsed``, ``simulations``, ``pushes``,
+    ``fixtures_placed``, ``plan_length``, ``method``, ``particles``, ``seed`` and
+    ``step_K`` (the choice made for nominal step K).
+    """
 
-@functools.cache
-def _repairer_class() -> type:
-    from unified_planning.engines import Engine
-    from unified_planning.engines.mixins import PlanRepairerMixin
+    _NAME = REPAIRER_NAME
 
-    class ArrangeUpFixtureRepairer(_engine_base(), PlanRepairerMixin):  # type: ignore[misc]
-        """Fixture-placement plan repair (thesis ch. 4,
-        :func:`arrange_up.repair.fixture_repair.repair_plan`):
-        ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
+    def __init__(
+        self,
+        particles: int = 150,
+        seed: int = 0,
+        method: str = "enhanced",
+        workers: int = 1,
+    ) -> None:
+        Engine.__init__(self)
+        PlanRepairerMixin.__init__(self)
+        _check_repairer_params(particles, seed, method, workers)
+        self._particles = particles
+        self._seed = seed
+        self._method = method
+        self._workers = workers
 
-        Parameters: ``particles`` (150), ``seed`` (0), ``method`` (``"enhanced"`` or
-        ``"naive"``), ``workers`` (1). The plan is the nominal plan to repair (a
-        ``SequentialPlan`` of place/push/pick); the result is a ``PlanGenerationResult``:
-        ``SOLVED_SATISFICING`` with the repaired plan, ``UNSOLVABLE_INCOMPLETELY`` when a step
-        could not be repaired (the log message says which and why; the repair is greedy, so
-        nothing is proven), ``UNSUPPORTED_PROBLEM`` when the problem or plan is not
-        arrange-up's (or the plan fails in the deterministic semantics), ``INTERNAL_ERROR`` when
-        the repair raised. Metrics: ``status``, ``elapsed``, ``simulations``, ``pushes``,
-        ``fixtures_placed``, ``plan_length``, ``method``, ``particles``, ``seed`` and
-        ``step_K`` (the choice made for nominal step K).
-        """
+    def _repair(self, problem: AbstractProblem, plan: Plan) -> PlanGenerationResult:
+        def result(
+            status: Status,
+            plan: Plan | None = None,
+            logs: Sequence[LogMessage] = (),
+            metrics: dict[str, str] | None = None,
+        ) -> PlanGenerationResult:
+            return PlanGenerationResult(
+                status, plan, REPAIRER_NAME, metrics=metrics, log_messages=list(logs) or None
+            )
 
-        _NAME = REPAIRER_NAME
+        def refuse(message: str) -> PlanGenerationResult:
+            return result(Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, message)])
 
-        def __init__(
-            self,
-            particles: int = 150,
-            seed: int = 0,
-            method: str = "enhanced",
-            workers: int = 1,
-        ) -> None:
-            Engine.__init__(self)
-            PlanRepairerMixin.__init__(self)
-            _check_repairer_params(particles, seed, method, workers)
-            self._particles = particles
-            self._seed = seed
-            self._method = method
-            self._workers = workers
-
-        def _repair(self, problem: Any, plan: Any) -> Any:
-            return _repair(self, problem, plan)
-
-    ArrangeUpFixtureRepairer.__module__ = __name__
-    ArrangeUpFixtureRepairer.__qualname__ = REPAIRER_CLASS
-    return ArrangeUpFixtureRepairer
+        read = _read_problem_and_plan(problem, plan)
+        if isinstance(read, str):
+            return refuse(read)
+        arrangement, nominal = read
+        try:
+            outcome = repair_plan(
+                arrangement,
+                nominal,
+                particles=self._particles,
+                seed=self._seed,
+                method=self._method,
+                workers=self._workers,
+            )
+        except ValueError as error:
+            return refuse(f"the plan cannot be repaired: {error}")
+        except Exception as error:  # the engine must answer, not raise
+            return result(
+                Status.INTERNAL_ERROR,
+                logs=[
+                    LogMessage(
+                        LogLevel.ERROR, f"{REPAIRER_NAME} failed: {type(error).__name__}: {error}"
+                    )
+                ],
+            )
+        stats = outcome.stats()
+        metrics = {key: _short(value) for key, value in stats.items()}
+        metrics.update(
+            status=outcome.status,
+            method=outcome.method,
+            particles=str(outcome.particles),
+            seed=str(outcome.seed),
+        )
+        for record in outcome.steps:
+            if record.kind != "push":
+                metrics[f"step_{record.index + 1}"] = f"{record.kind} kept"
+            elif record.status != "ok":
+                metrics[f"step_{record.index + 1}"] = "failed"
+            else:
+                where = (
+                    "no fixture" if record.pose is None else f"{record.fixture} at {record.pose}"
+                )
+                metrics[f"step_{record.index + 1}"] = f"{where}, x{record.multiplier:g}"
+        if not outcome.solved or outcome.actions is None:
+            return result(
+                Status.UNSOLVABLE_INCOMPLETELY,
+                None,
+                [LogMessage(LogLevel.INFO, f"the repair {outcome.status}: {outcome.reason}")],
+                metrics,
+            )
+        repaired, logs = _plan_to_up(problem, arrangement, outcome.actions)
+        return result(Status.SOLVED_SATISFICING, repaired, logs, metrics)
 
 
 def _check_repairer_params(particles: Any, seed: Any, method: Any, workers: Any) -> None:
-    def positive(value: Any) -> bool:
-        return isinstance(value, int) and not isinstance(value, bool) and value >= 1
-
-    if not positive(particles):
+    if not _positive(particles):
         raise ValueError(
             f"{REPAIRER_NAME}: particles must be a positive integer, got {particles!r}"
         )
@@ -684,70 +619,5 @@ def _check_repairer_params(particles: Any, seed: Any, method: Any, workers: Any)
         raise ValueError(f"{REPAIRER_NAME}: seed must be an integer, got {seed!r}")
     if method not in ("naive", "enhanced"):
         raise ValueError(f"{REPAIRER_NAME}: method must be 'naive' or 'enhanced', got {method!r}")
-    if not positive(workers):
+    if not _positive(workers):
         raise ValueError(f"{REPAIRER_NAME}: workers must be a positive integer, got {workers!r}")
-
-
-def _repair(engine: Any, problem: Any, plan: Any) -> Any:
-    from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
-    from unified_planning.engines import PlanGenerationResultStatus as Status
-
-    from arrange_up.repair.fixture_repair import repair_plan
-
-    def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
-        return PlanGenerationResult(
-            status, plan, REPAIRER_NAME, metrics=metrics, log_messages=list(logs) or None
-        )
-
-    def refuse(message: str) -> Any:
-        return result(Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, message)])
-
-    read = _read_problem_and_plan(problem, plan)
-    if isinstance(read, str):
-        return refuse(read)
-    arrangement, nominal = read
-    try:
-        outcome = repair_plan(
-            arrangement,
-            nominal,
-            particles=engine._particles,
-            seed=engine._seed,
-            method=engine._method,
-            workers=engine._workers,
-        )
-    except ValueError as error:
-        return refuse(f"the plan cannot be repaired: {error}")
-    except Exception as error:  # the engine must answer, not raise
-        return result(
-            Status.INTERNAL_ERROR,
-            logs=[
-                LogMessage(
-                    LogLevel.ERROR, f"{REPAIRER_NAME} failed: {type(error).__name__}: {error}"
-                )
-            ],
-        )
-    stats = outcome.stats()
-    metrics = {key: _short(value) for key, value in stats.items()}
-    metrics.update(
-        status=outcome.status,
-        method=outcome.method,
-        particles=str(outcome.particles),
-        seed=str(outcome.seed),
-    )
-    for record in outcome.steps:
-        if record.kind != "push":
-            metrics[f"step_{record.index + 1}"] = f"{record.kind} kept"
-        elif record.status != "ok":
-            metrics[f"step_{record.index + 1}"] = "failed"
-        else:
-            where = "no fixture" if record.pose is None else f"{record.fixture} at {record.pose}"
-            metrics[f"step_{record.index + 1}"] = f"{where}, x{record.multiplier:g}"
-    if not outcome.solved or outcome.actions is None:
-        return result(
-            Status.UNSOLVABLE_INCOMPLETELY,
-            None,
-            [LogMessage(LogLevel.INFO, f"the repair {outcome.status}: {outcome.reason}")],
-            metrics,
-        )
-    repaired, logs = _plan_to_up(problem, arrangement, outcome.actions)
-    return result(Status.SOLVED_SATISFICING, repaired, logs, metrics)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import pickle
 import runpy
 import subprocess
 import sys
@@ -18,6 +19,7 @@ from unified_planning.io import PDDLReader
 from unified_planning.shortcuts import OneshotPlanner, PlanValidator
 
 import arrange_up.up.engines as engines
+import arrange_up.up.registration as registration
 from arrange_up.io.domains import domains_dir, load
 from arrange_up.io.pddl import domain_path
 from arrange_up.up.compile import from_up, to_up
@@ -116,20 +118,64 @@ def test_registration_is_idempotent_and_has_no_credits():
     assert planner.name == "arrange-up"
 
 
-def test_register_before_unified_planning_is_imported():
-    code = (
-        "import sys, arrange_up.up.engines as e\n"
-        "e.register()\n"
-        "assert 'unified_planning' not in sys.modules, 'register imported unified_planning'\n"
-        "from unified_planning.shortcuts import OneshotPlanner\n"
-        "with OneshotPlanner(name='arrange-up', params={'semantics': 'deterministic'}) as p:\n"
-        "    print(p.name)\n"
-    )
+# Each order runs in a fresh interpreter: the registration depends on what is imported first.
+_IMPORT_ORDERS = {
+    "arrange_up first": (
+        "import sys\n"
+        "import arrange_up\n"
+        "assert 'unified_planning' not in sys.modules, 'import arrange_up imported UP'\n"
+        "assert 'arrange_up.up.engines' not in sys.modules, 'import arrange_up imported engines'\n"
+        "from unified_planning.shortcuts import OneshotPlanner, get_environment\n"
+    ),
+    "unified_planning first": (
+        "from unified_planning.shortcuts import OneshotPlanner, get_environment\n"
+        "import arrange_up\n"
+    ),
+    "unified_planning's environment first": (
+        "from unified_planning.shortcuts import OneshotPlanner, get_environment\n"
+        "get_environment()\n"
+        "import arrange_up\n"
+    ),
+}
+_SELECT_AND_SOLVE = """
+import sys
+from arrange_up.up.registration import _FactoryHook
+assert not any(isinstance(f, _FactoryHook) for f in sys.meta_path), 'the hook outlived its use'
+from arrange_up.io.domains import load
+from arrange_up.up.compile import to_up
+factory = get_environment().factory
+names = ('arrange-up', 'arrange-up-reliability', 'arrange-up-fixtures')
+assert all(factory.engines.count(name) == 1 for name in names), factory.engines
+problem = to_up(load('blocks-1'))
+with OneshotPlanner(name='arrange-up', params={'semantics': 'deterministic'}) as planner:
+    print(planner.name, type(planner).__module__, planner.solve(problem).status.name)
+with OneshotPlanner(problem_kind=problem.kind) as planner:
+    print(planner.name)
+"""
+
+
+@pytest.mark.parametrize("order", sorted(_IMPORT_ORDERS))
+def test_the_engines_are_registered_in_either_import_order(order):
     done = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT
+        [sys.executable, "-c", _IMPORT_ORDERS[order] + _SELECT_AND_SOLVE],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
     )
     assert done.returncode == 0, done.stderr
-    assert done.stdout.strip() == "arrange-up"
+    assert done.stdout.split("\n")[:2] == [
+        "arrange-up arrange_up.up.engines SOLVED_SATISFICING",
+        "arrange-up",
+    ]
+
+
+def test_the_engine_classes_are_module_level_and_picklable():
+    for name, module, class_name in registration.ENGINES:
+        cls = getattr(engines, class_name)
+        assert (cls.__module__, cls.__qualname__) == (module, class_name)
+        assert get_environment().factory.engines.count(name) == 1
+    assert pickle.loads(pickle.dumps(engines.ArrangeUpPlanner)) is engines.ArrangeUpPlanner
 
 
 def test_the_example_runs(capsys):
