@@ -1,8 +1,9 @@
 """A catalogue of tiny problems that tests pick by name.
 
 Each entry is YAML text in the problem format (``docs/problem-format.md``), loaded through the
-public loader, so the catalogue exercises the same path users take. Entries are as small as the
-concern they serve allows (one or two parts, one paddle), so that tests built on them stay fast.
+public loader (refusing warnings too), so the catalogue exercises the same path users take.
+Entries are as small as the concern they serve allows (one or two parts, one paddle, small
+tables), so that tests built on them stay fast.
 
 From a test, either take the fixtures of ``tests/conftest.py`` (``tiny`` is :func:`tiny`;
 ``problem`` is parametrised indirectly by name) or import this module directly
@@ -15,7 +16,7 @@ from __future__ import annotations
 
 from functools import cache
 
-from arrange_up.io.yaml_problem import load_problem_text
+from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.problem import ArrangementProblem
 
 TEXTS: dict[str, str] = {
@@ -141,7 +142,7 @@ def text(name: str) -> str:
 @cache
 def tiny(name: str) -> ArrangementProblem:
     """Catalogue entry ``name``, loaded (once) through the public YAML loader."""
-    return load_problem_text(text(name), source=f"catalogue:{name}")
+    return _load(text(name), f"catalogue:{name}")
 
 
 def variant(name: str, old: str, new: str) -> ArrangementProblem:
@@ -149,4 +150,14 @@ def variant(name: str, old: str, new: str) -> ArrangementProblem:
     base = text(name)
     if old not in base:
         raise ValueError(f"{old!r} does not occur in catalogue entry {name!r}")
-    return load_problem_text(base.replace(old, new), source=f"catalogue:{name}*")
+    return _load(base.replace(old, new), f"catalogue:{name}*")
+
+
+def _load(yaml_text: str, source: str) -> ArrangementProblem:
+    # Warnings are refused too: a misspelt optional key (``uncertainity:``) is only a warning
+    # to the loader, and would silently turn a tiny problem into another one.
+    problem, diagnostics = check_problem_text(yaml_text, source)
+    if diagnostics:
+        raise ValueError("\n".join(str(d) for d in diagnostics))
+    assert problem is not None
+    return problem

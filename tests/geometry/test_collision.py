@@ -40,9 +40,8 @@ def notch_centre(problem) -> tuple[float, float]:
 
 
 # -- construction ---------------------------------------------------------------------------
-@pytest.mark.parametrize("name", NAMES)
-def test_builds_walls_and_obstacles_of_every_catalogue_problem(name):
-    problem = tiny(name)
+@pytest.mark.parametrize("problem", NAMES, indirect=True)
+def test_builds_walls_and_obstacles_of_every_catalogue_problem(problem):
     checker = CollisionChecker(problem)
     assert tuple(checker.walls) == problem.table.walls
     assert set(checker.obstacles) == {spec.name for spec in problem.obstacles}

@@ -49,9 +49,10 @@ def test_an_unknown_name_is_refused_with_the_known_ones():
 
 
 @pytest.mark.parametrize("name", HEURISTICS)
-@pytest.mark.parametrize("problem_name", ["one-block", "two-blocks-row", "l-part", "millimetres"])
-def test_every_heuristic_is_zero_at_a_goal_belief(name, problem_name):
-    problem = tiny(problem_name)
+@pytest.mark.parametrize(
+    "problem", ["one-block", "two-blocks-row", "l-part", "millimetres"], indirect=True
+)
+def test_every_heuristic_is_zero_at_a_goal_belief(name, problem):
     belief = at_goal(problem)
     assert GoalTest(problem).satisfied_array(belief.poses, belief.names())
     value = heuristic(name, problem)(belief)
