@@ -146,11 +146,18 @@ def tiny(name: str) -> ArrangementProblem:
 
 
 def variant(name: str, old: str, new: str) -> ArrangementProblem:
-    """Catalogue entry ``name`` with the text ``old`` replaced by ``new`` (which must occur)."""
+    """Catalogue entry ``name`` with the text ``old`` (which must occur exactly once) replaced
+    by ``new``."""
     base = text(name)
-    if old not in base:
-        raise ValueError(f"{old!r} does not occur in catalogue entry {name!r}")
+    if base.count(old) != 1:
+        raise ValueError(f"{old!r} occurs {base.count(old)} times in catalogue entry {name!r}")
     return _load(base.replace(old, new), f"catalogue:{name}*")
+
+
+def with_planning(name: str, hints: str) -> ArrangementProblem:
+    """Catalogue entry ``name`` with the ``planning:`` hints ``hints`` (a YAML flow mapping,
+    e.g. ``'{push_distances: [0.5]}'``); no entry has hints of its own."""
+    return _load(f"{text(name)}planning: {hints}\n", f"catalogue:{name}+planning")
 
 
 def _load(yaml_text: str, source: str) -> ArrangementProblem:

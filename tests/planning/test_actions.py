@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from catalogue import tiny, variant
+from catalogue import tiny, variant, with_planning
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
@@ -38,11 +38,6 @@ def direction_of(push: Push) -> str:
 
 def distances(pushes, direction: str) -> list[float]:
     return sorted({p.distance for p in pushes if direction_of(p) == direction})
-
-
-def with_hints(name: str, hints: str):
-    """Catalogue entry ``name`` with a ``planning:`` mapping."""
-    return variant(name, "uncertainty:", f"planning: {hints}\nuncertainty:")
 
 
 # -- candidates ----------------------------------------------------------------------------
@@ -110,7 +105,7 @@ def test_default_place_grid_steps_by_the_shadow_growth_plus_a_tenth():
 
 def test_place_hints_replace_the_grid_and_add_angles():
     hints = "{place_offsets: [[-1, 1], [-2, 1], [0, 0]], place_angles: [0, 45]}"
-    problem = with_hints("one-block", hints)
+    problem = with_planning("one-block", hints)
     gen = generator(problem)
     assert gen.offsets["A"] == ((-1.0, 1.0), (-2.0, 1.0), (0.0, 0.0))
     quarter = math.radians(45)
@@ -184,15 +179,46 @@ def test_pushes_go_towards_the_goal_to_the_wall_and_to_the_goal_coordinate():
     assert 0.0 < part[0] - paddle[2] < 0.05
 
 
-def test_no_push_to_a_missing_wall_and_none_towards_an_obstacle():
-    problem = tiny("obstacle")  # walls left and bottom only
-    gen = generator(problem)
+def test_a_part_is_never_pushed_away_from_its_goal_beyond_the_tolerance():
+    # An extra push distance makes every direction a candidate; the goal (A at x = 5, y = 0.5,
+    # tolerance 0.2) rules out the directions away from it.
+    gen = generator(with_planning("obstacle", "{push_distances: [0.5]}"))
+
+    def directions(x):
+        return {direction_of(p) for p in gen.pushes(belief(A=((x, 2.5, 0.0), SMALL)))}
+
+    assert directions(2.5) == {"+x", "-y"}
+    assert directions(4.7) == {"+x", "-y"}  # 0.3 short of the goal: -x would move it away
+    assert directions(4.9) == {"+x", "-x", "-y"}  # within the tolerance: either way
+
+
+def test_no_push_to_a_missing_wall():
+    gen = generator(tiny("obstacle"))  # walls left and bottom only; goal A at (5, 0.5)
     pushes = gen.pushes(belief(A=((2.0, 2.5, 0.0), SMALL)))
-    # +x: to the goal's x only (there is no right wall); -y: down to the goal row, not the
-    # wall, since the post stands beside the goal.
+    # +x: to the goal's x only, since there is no right wall; -y: to the goal's y and to the
+    # bottom wall, which holds A in the goal.
     assert len(distances(pushes, "+x")) == 1
-    for push in pushes:
-        assert not gen.checker.shadow_hits_fixed("paddle", push.pose, gen.push_unc)
+    assert len(distances(pushes, "-y")) == 2
+
+
+def test_a_push_beside_an_obstacle_is_shifted_clear_of_it_or_dropped():
+    with_post = generator(tiny("obstacle"))  # the post covers [2.5, 3.5] x [0, 1]
+    post = "  post: {kind: obstacle, shape: {box: [1, 1]}, pose: [3, 0.5, 0]}\n"
+    without = generator(variant("obstacle", post, ""))
+
+    def east(gen, y):
+        pushes = gen.pushes(belief(A=((4.2, y, 0.0), SMALL)))
+        return {p.pose for p in pushes if direction_of(p) == "+x"}
+
+    # The paddle behind A stands level with the post: it moves up along its long side ...
+    ((_, y_clear, _),) = east(with_post, 1.6)
+    ((_, y_free, _),) = east(without, 1.6)
+    assert y_free == 1.6 and y_clear > 1.6
+    for gen in (with_post, without):
+        for pose in east(gen, 1.6):
+            assert not gen.checker.shadow_hits_fixed("paddle", pose, gen.push_unc)
+    # ... unless that would leave A's centre uncovered: then there is no such push.
+    assert east(with_post, 1.0) == set() and len(east(without, 1.0)) == 1
 
 
 def test_a_push_beside_a_wall_is_shifted_along_the_paddle_but_still_covers_the_part():
@@ -232,7 +258,7 @@ def test_relative_goals_have_no_wall_trains():
 
 
 def test_push_hints_restrict_directions_and_add_distances():
-    problem = with_hints("one-block", '{push_directions: ["+x"], push_distances: [0.5, 0.501]}')
+    problem = with_planning("one-block", '{push_directions: ["+x"], push_distances: [0.5, 0.501]}')
     gen = generator(problem)
     assert gen.directions == ("+x",) and set(DIRECTIONS) >= set(gen.directions)
     pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from catalogue import tiny, variant
+from catalogue import tiny, with_planning
 
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import AngleFrame, ParticleBelief
@@ -208,11 +208,7 @@ def test_the_ordering_filter_ignores_relative_goals():
 @pytest.fixture(scope="module")
 def tight_offsets():
     """two-blocks-row whose B may be placed only where A's goal footprint reaches."""
-    return variant(
-        "two-blocks-row",
-        "uncertainty:",
-        "planning: {place_offsets: [[0, 0.4], [0.4, 0.4]]}\nuncertainty:",
-    )
+    return with_planning("two-blocks-row", "{place_offsets: [[0, 0.4], [0.4, 0.4]]}")
 
 
 def test_a_part_walled_in_by_a_part_placed_out_of_order_is_infinite(tight_offsets):
