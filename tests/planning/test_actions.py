@@ -11,7 +11,7 @@ from catalogue import tiny, variant, with_planning
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.world import Pick, Place, Push
-from arrange_up.planning.actions import DIRECTIONS, MIN_PUSH, ActionGenerator
+from arrange_up.planning.actions import MIN_PUSH, ActionGenerator
 
 NONE = (0.0, 0.0, 0.0)
 SMALL = (0.1, 0.1, 0.05)  # a belief interval's half-widths after a push or two
@@ -82,7 +82,8 @@ def test_the_same_problem_in_millimetres_gets_the_same_candidates():
     inch, mm = generator(tiny("one-block")), generator(tiny("millimetres"))
     assert mm.candidates(IntervalBelief(())) == inch.candidates(IntervalBelief(()))
     on_table = belief(A=((2.5, 1.5, 0.0), SMALL))
-    assert mm.candidates(on_table) == pytest.approx(inch.candidates(on_table))
+    # Exactly: generated poses and distances are rounded (to 1e-6 in and 1e-4 in).
+    assert mm.candidates(on_table) == inch.candidates(on_table)
 
 
 # -- place ---------------------------------------------------------------------------------
@@ -260,7 +261,7 @@ def test_relative_goals_have_no_wall_trains():
 def test_push_hints_restrict_directions_and_add_distances():
     problem = with_planning("one-block", '{push_directions: ["+x"], push_distances: [0.5, 0.501]}')
     gen = generator(problem)
-    assert gen.directions == ("+x",) and set(DIRECTIONS) >= set(gen.directions)
+    assert gen.directions == ("+x",)
     pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))
     assert {direction_of(p) for p in pushes} == {"+x"}
     gap = 2.0 - (pushes[0].pose[0] + PADDLE_HALF_THICKNESS)
@@ -304,10 +305,10 @@ def test_parts_are_never_picked():
 
 
 def test_push_that_clips_a_neighbour_is_also_offered_clear_of_it():
-    # A row of three blocks ends at C; D has just been placed beside it. Pushing D down from a
-    # paddle centred on D clips the side of C's shadow (the paddle may or may not touch C), so
-    # with unclipped_pushes the same push is offered a second time from where the paddle misses
-    # C or covers it whole.
+    # A row of three blocks ends at C (here A); D (here B) has just been placed beside it.
+    # Pushing D down from a paddle centred on D clips the side of C's shadow (the paddle may or
+    # may not touch C), so with unclipped_pushes the same push is offered a second time from
+    # where the paddle misses C or covers it whole.
     p = tiny("two-blocks-row")
     checker = CollisionChecker(p)
     gen = ActionGenerator(p, checker, unclipped_pushes=True)
