@@ -1,0 +1,343 @@
+"""Tests of ``arrange_up.planning.actions``: the candidate places, pushes and picks of a belief,
+their preconditions, the planning hints that shape them and the unclipped-pushes option."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from catalogue import tiny, variant, with_planning
+
+from arrange_up.belief.states import IntervalBelief, ObjectInterval
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.world import Pick, Place, Push
+from arrange_up.planning.actions import MIN_PUSH, ActionGenerator
+
+NONE = (0.0, 0.0, 0.0)
+SMALL = (0.1, 0.1, 0.05)  # a belief interval's half-widths after a push or two
+#: Paddle angle that pushes along each direction (the paddle pushes along its own +y).
+THETA = {"+x": -math.pi / 2, "-x": math.pi / 2, "+y": 0.0, "-y": -math.pi}
+PADDLE_HALF_THICKNESS = 0.075
+
+
+def generator(problem, **options) -> ActionGenerator:
+    return ActionGenerator(problem, CollisionChecker(problem), **options)
+
+
+def belief(**intervals) -> IntervalBelief:
+    """An interval belief from ``name=(center, half)`` (in the problem's object order)."""
+    return IntervalBelief(
+        tuple((name, ObjectInterval(tuple(c), tuple(h))) for name, (c, h) in intervals.items())
+    )
+
+
+def direction_of(push: Push) -> str:
+    (name,) = [d for d, theta in THETA.items() if math.isclose(push.pose[2], theta)]
+    return name
+
+
+def distances(pushes, direction: str) -> list[float]:
+    return sorted({p.distance for p in pushes if direction_of(p) == direction})
+
+
+# -- candidates ----------------------------------------------------------------------------
+def test_candidates_are_places_then_pushes_then_picks():
+    problem = tiny("block-and-fixture")
+    gen = generator(problem)
+    bar = (problem.initial_of("bar").pose, NONE)
+    start = gen.candidates(belief(bar=bar))
+    assert [type(a) for a in start] == [Place, Pick]
+    assert start[-1] == Pick("bar")
+    placed = gen.candidates(belief(A=((3.0, 1.5, 0.0), SMALL), bar=bar))
+    kinds = [type(a).__name__ for a in placed]
+    assert kinds == sorted(kinds, key=["Place", "Push", "Pick"].index)
+    assert "Place" not in kinds and "Push" in kinds and placed[-1] == Pick("bar")
+
+
+def test_generated_actions_satisfy_their_preconditions():
+    p = tiny("two-blocks-row")
+    checker = CollisionChecker(p)
+    gen = ActionGenerator(p, checker)
+    empty = IntervalBelief(())
+    places = gen.places(empty)
+    assert {a.obj for a in places} == {"A", "B"}
+    for action in places:
+        assert checker.shadow_inside_table(action.obj, action.pose, p.uncertainty.place)
+        assert not checker.shadow_hits_fixed(action.obj, action.pose, p.uncertainty.place)
+    a_placed = IntervalBelief((("A", ObjectInterval((9.088, 0.912, 0.0), p.uncertainty.place)),))
+    pushes = gen.pushes(a_placed)
+    assert pushes and all(isinstance(a, Push) for a in pushes)
+    directions = set()
+    for push in pushes:
+        shadows = [("A", (9.088, 0.912, 0.0), p.uncertainty.place)]
+        assert checker.shadow_clear("paddle", push.pose, p.uncertainty.push, shadows)
+        directions.add(round(push.pose[2], 3))
+    # Against the right and bottom walls only +x (theta -pi/2) and -y (theta pi) fit.
+    assert directions == {round(-math.pi / 2, 3), round(-math.pi, 3)}
+    # A push towards the wall and one to the goal coordinate are both offered.
+    assert len({p.distance for p in pushes if round(p.pose[2], 3) == round(-math.pi / 2, 3)}) == 2
+
+
+def test_the_same_problem_in_millimetres_gets_the_same_candidates():
+    inch, mm = generator(tiny("one-block")), generator(tiny("millimetres"))
+    assert mm.candidates(IntervalBelief(())) == inch.candidates(IntervalBelief(()))
+    on_table = belief(A=((2.5, 1.5, 0.0), SMALL))
+    # Exactly: generated poses and distances are rounded (to 1e-6 in and 1e-4 in).
+    assert mm.candidates(on_table) == inch.candidates(on_table)
+
+
+# -- place ---------------------------------------------------------------------------------
+def test_default_place_grid_steps_by_the_shadow_growth_plus_a_tenth():
+    problem = tiny("one-block")
+    gen = generator(problem)
+    checker = gen.checker
+    nominal = checker.shadow_box("A", NONE, NONE)
+    shadow = checker.shadow_box("A", NONE, problem.uncertainty.place)
+    step = round(nominal[0] - shadow[0] + 0.1, 3)
+    assert step == 0.412
+    grid = gen.offsets["A"]
+    assert len(grid) == 9 and set(grid) == {
+        (i * step, j * step) for i in (-1, 0, 1) for j in (-1, 0, 1)
+    }
+    # In the corner, only the offset up and to the left keeps the place shadow on the table.
+    (place,) = gen.places(IntervalBelief(()))
+    assert place.obj == "A" and place.pose == pytest.approx((4.5 - step, 0.5 + step, 0.0))
+
+
+def test_place_hints_replace_the_grid_and_add_angles():
+    hints = "{place_offsets: [[-1, 1], [-2, 1], [0, 0]], place_angles: [0, 45]}"
+    problem = with_planning("one-block", hints)
+    gen = generator(problem)
+    assert gen.offsets["A"] == ((-1.0, 1.0), (-2.0, 1.0), (0.0, 0.0))
+    quarter = math.radians(45)
+    # The target's own angle once (the 0 offset repeats it), then 45 degrees from it; the
+    # offset (0, 0) puts the shadow over the walls and is refused.
+    assert gen.places(IntervalBelief(())) == [
+        Place("A", (3.5, 1.5, 0.0)),
+        Place("A", (3.5, 1.5, quarter)),
+        Place("A", (2.5, 1.5, 0.0)),
+        Place("A", (2.5, 1.5, quarter)),
+    ]
+
+
+def test_places_skip_parts_on_the_table_and_honour_only():
+    gen = generator(tiny("two-blocks-row"))
+    empty = IntervalBelief(())
+    assert {a.obj for a in gen.places(empty, only="B")} == {"B"}
+    a_on = belief(A=((5.0, 2.5, 0.0), SMALL))
+    assert {a.obj for a in gen.places(a_on)} == {"B"}
+    assert gen.places(a_on, only="A") == []
+
+
+def test_place_poses_ignore_the_objects_on_the_table_but_not_the_walls():
+    problem = tiny("two-blocks-row")
+    gen = generator(problem)
+    # A sits on B's target: no place of B is clear of it, yet B's place poses (the half of the
+    # precondition about the table, walls and obstacles) are all still there.
+    blocking = belief(A=((8.5, 0.9, 0.0), problem.uncertainty.place))
+    assert gen.places(blocking, only="B") == []
+    poses = gen.place_poses(blocking, "B")
+    assert poses and poses == gen.place_poses(IntervalBelief(()), "B")
+    for pose in poses:
+        assert gen.checker.shadow_inside_table("B", pose, gen.place_unc)
+        assert not gen.checker.shadow_hits_fixed("B", pose, gen.place_unc)
+    assert gen.place_poses(blocking, "paddle") == []  # no goal, no target
+
+
+def test_place_target_of_an_absolute_goal_is_the_goal_pose():
+    problem = tiny("two-blocks-row")
+    gen = generator(problem)
+    assert gen.place_target("A", IntervalBelief(())) == problem.goal.target("A")
+    assert gen.place_target("paddle", IntervalBelief(())) is None
+
+
+def test_place_candidates_for_relative_goal_follow_reference():
+    p = variant("relative-goal", "  U: {pose: [8, 8, 0], uncertainty: [0.3, 0.3, 5]}\n", "")
+    gen = ActionGenerator(p, CollisionChecker(p))
+    t = IntervalBelief((("T", ObjectInterval((4.0, 4.0, math.pi / 2), (0.0, 0.0, 0.0))),))
+    target = gen.place_target("U", t)
+    assert target == pytest.approx((4.0, 6.0, math.pi / 2))
+    assert all(isinstance(a, Place) and a.obj == "U" for a in gen.places(t))
+    # Without the reference on the table there is no target, hence no place.
+    assert gen.place_target("U", IntervalBelief(())) is None
+    assert [a for a in gen.places(IntervalBelief(())) if a.obj == "U"] == []
+
+
+# -- push ----------------------------------------------------------------------------------
+def test_pushes_go_towards_the_goal_to_the_wall_and_to_the_goal_coordinate():
+    gen = generator(tiny("one-block"))  # goal A at (4.5, 0.5), against the right and bottom walls
+    pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))
+    assert {direction_of(p) for p in pushes} == {"+x", "-y"}  # never away from the goal
+    (plus_x,) = {p.pose for p in pushes if direction_of(p) == "+x"}
+    front = plus_x[0] + PADDLE_HALF_THICKNESS
+    # Until A's centre reaches the goal's x (A's rear, at 2.0, travels 2.0), and the paddle's
+    # front all the way to the right wall (x = 5).
+    assert distances(pushes, "+x") == pytest.approx([4.0 - front, 5.0 - front], abs=1e-4)
+    assert plus_x[1] == 1.5  # centred on the part across the push
+    # The approach shadow stops short of the part's shadow.
+    part = gen.checker.shadow_box("A", (2.5, 1.5, 0.0), SMALL)
+    paddle = gen.checker.shadow_box("paddle", plus_x, gen.push_unc)
+    assert 0.0 < part[0] - paddle[2] < 0.05
+
+
+def test_a_part_is_never_pushed_away_from_its_goal_beyond_the_tolerance():
+    # An extra push distance makes every direction a candidate; the goal (A at x = 5, y = 0.5,
+    # tolerance 0.2) rules out the directions away from it.
+    gen = generator(with_planning("obstacle", "{push_distances: [0.5]}"))
+
+    def directions(x):
+        return {direction_of(p) for p in gen.pushes(belief(A=((x, 2.5, 0.0), SMALL)))}
+
+    assert directions(2.5) == {"+x", "-y"}
+    assert directions(4.7) == {"+x", "-y"}  # 0.3 short of the goal: -x would move it away
+    assert directions(4.9) == {"+x", "-x", "-y"}  # within the tolerance: either way
+
+
+def test_no_push_to_a_missing_wall():
+    gen = generator(tiny("obstacle"))  # walls left and bottom only; goal A at (5, 0.5)
+    pushes = gen.pushes(belief(A=((2.0, 2.5, 0.0), SMALL)))
+    # +x: to the goal's x only, since there is no right wall; -y: to the goal's y and to the
+    # bottom wall, which holds A in the goal.
+    assert len(distances(pushes, "+x")) == 1
+    assert len(distances(pushes, "-y")) == 2
+
+
+def test_a_push_beside_an_obstacle_is_shifted_clear_of_it_or_dropped():
+    with_post = generator(tiny("obstacle"))  # the post covers [2.5, 3.5] x [0, 1]
+    post = "  post: {kind: obstacle, shape: {box: [1, 1]}, pose: [3, 0.5, 0]}\n"
+    without = generator(variant("obstacle", post, ""))
+
+    def east(gen, y):
+        pushes = gen.pushes(belief(A=((4.2, y, 0.0), SMALL)))
+        return {p.pose for p in pushes if direction_of(p) == "+x"}
+
+    # The paddle behind A stands level with the post: it moves up along its long side ...
+    ((_, y_clear, _),) = east(with_post, 1.6)
+    ((_, y_free, _),) = east(without, 1.6)
+    assert y_free == 1.6 and y_clear > 1.6
+    for gen in (with_post, without):
+        for pose in east(gen, 1.6):
+            assert not gen.checker.shadow_hits_fixed("paddle", pose, gen.push_unc)
+    # ... unless that would leave A's centre uncovered: then there is no such push.
+    assert east(with_post, 1.0) == set() and len(east(without, 1.0)) == 1
+
+
+def test_a_push_beside_a_wall_is_shifted_along_the_paddle_but_still_covers_the_part():
+    gen = generator(tiny("one-block"))
+    pushes = gen.pushes(belief(A=((0.5, 2.0, 0.0), NONE)))  # flush with the left wall
+    assert {direction_of(p) for p in pushes} == {"-y"}  # no room behind it for +x
+    (x,) = {p.pose[0] for p in pushes}
+    assert x > 0.5  # moved right, clear of the left wall ...
+    assert x - 0.5 <= 0.5 * 2.5 - 0.1 + 1e-9  # ... while still covering the part's centre
+    box = gen.checker.shadow_box("paddle", pushes[0].pose, gen.push_unc)
+    assert box[0] > 0.0
+
+
+def test_wall_pushes_wait_for_the_train_of_parts_ahead():
+    gen = generator(tiny("two-blocks-row"))
+    # The goal holds B against the right wall only through A; A against the right wall itself.
+    assert gen.wall_trains[("B", "+x")] == ("A",)
+    assert gen.wall_trains[("A", "+x")] == ()
+    assert gen.wall_trains[("B", "-y")] == ()
+    assert gen.wall_trains[("A", "+y")] is None and gen.wall_trains[("B", "-x")] is None
+    b_alone = belief(B=((5.0, 2.5, 0.0), SMALL))
+    both = belief(A=((9.3, 0.7, 0.0), SMALL), B=((5.0, 2.5, 0.0), SMALL))
+
+    def b_east(b):
+        return [p for p in gen.pushes(b) if direction_of(p) == "+x" and p.pose[1] == 2.5]
+
+    (to_goal,) = distances(b_east(b_alone), "+x")  # to B's goal x only: A is not there yet
+    to_goal_too, to_wall = distances(b_east(both), "+x")
+    assert to_goal_too == to_goal
+    # To the goal: until B's centre reaches x = 8.5 (the paddle's front at 8.0); to the wall:
+    # the paddle's front all the way to x = 10 (the controller stalls against the train).
+    assert to_wall == pytest.approx(to_goal + 2.0, abs=1e-4)
+
+
+def test_relative_goals_have_no_wall_trains():
+    assert generator(tiny("relative-goal")).wall_trains == {}
+
+
+def test_push_hints_restrict_directions_and_add_distances():
+    problem = with_planning("one-block", '{push_directions: ["+x"], push_distances: [0.5, 0.501]}')
+    gen = generator(problem)
+    assert gen.directions == ("+x",)
+    pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))
+    assert {direction_of(p) for p in pushes} == {"+x"}
+    gap = 2.0 - (pushes[0].pose[0] + PADDLE_HALF_THICKNESS)
+    # 0.5 and 0.501 are one candidate (DISTANCE_RESOLUTION); wall and goal as before.
+    assert distances(pushes, "+x") == pytest.approx([gap + 0.5, gap + 2.0, gap + 3.0], abs=1e-4)
+
+
+def test_a_part_at_its_goal_coordinate_gets_no_push_to_it():
+    gen = generator(tiny("one-block"))
+    at_x = belief(A=((4.5 - MIN_PUSH / 2, 1.5, 0.0), SMALL))
+    pushes = gen.pushes(at_x)
+    (pose,) = {p.pose for p in pushes if direction_of(p) == "+x"}
+    # To the right wall only: the goal's x is less than MIN_PUSH ahead.
+    assert distances(pushes, "+x") == pytest.approx(
+        [5.0 - pose[0] - PADDLE_HALF_THICKNESS], abs=1e-4
+    )
+    pushes = generator(tiny("obstacle")).pushes(belief(A=((5.0 - MIN_PUSH / 2, 2.5, 0.0), SMALL)))
+    assert "+x" not in {direction_of(p) for p in pushes}  # nothing to gain, and no wall
+
+
+def test_push_poses_and_distances_are_rounded():
+    pushes = generator(tiny("l-part")).pushes(belief(L=((2.0, 2.0, 0.0), (0.1, 0.1, 0.0873))))
+    assert pushes
+    for push in pushes:
+        assert push.pose[:2] == tuple(round(v, 6) for v in push.pose[:2])
+        assert push.distance == round(push.distance, 4) and push.distance > MIN_PUSH
+
+
+def test_a_manipulator_on_the_table_does_not_push_and_may_be_picked():
+    gen = generator(tiny("one-block"))
+    on = belief(A=((2.5, 1.5, 0.0), SMALL), paddle=((2.5, 0.2, 0.0), NONE))
+    assert gen.pushes(on) == []
+    assert gen.picks(on) == [Pick("paddle")]
+
+
+def test_parts_are_never_picked():
+    gen = generator(tiny("block-and-fixture"))
+    on = belief(A=((3.0, 1.5, 0.0), SMALL), bar=((1.0, 2.0, 0.0), NONE))
+    assert gen.picks(on) == [Pick("bar")]
+    assert gen.picks(belief(A=((3.0, 1.5, 0.0), SMALL))) == []
+
+
+def test_push_that_clips_a_neighbour_is_also_offered_clear_of_it():
+    # A row of three blocks ends at C (here A); D (here B) has just been placed beside it.
+    # Pushing D down from a paddle centred on D clips the side of C's shadow (the paddle may or
+    # may not touch C), so with unclipped_pushes the same push is offered a second time from
+    # where the paddle misses C or covers it whole.
+    p = tiny("two-blocks-row")
+    checker = CollisionChecker(p)
+    gen = ActionGenerator(p, checker, unclipped_pushes=True)
+    c_iv = ObjectInterval((7.513, 0.564, 0.0), (0.027, 0.064, math.radians(3.2)))
+    d_iv = ObjectInterval((6.088, 0.912, 0.0), p.uncertainty.place)
+    state = IntervalBelief((("A", c_iv), ("B", d_iv)))
+    half = 0.5 * 2.5  # the paddle's half length
+
+    def centres_pushing_d_down(state, gen=gen):
+        # Pushes down (theta -pi) whose paddle covers D's centre with 0.1 in to spare.
+        return sorted(
+            {
+                a.pose[0]
+                for a in gen.pushes(state)
+                if round(a.pose[2], 3) == round(-math.pi, 3) and abs(a.pose[0] - 6.088) < half
+            }
+        )
+
+    centres = centres_pushing_d_down(state)
+    assert len(centres) == 2
+    assert 6.088 in centres  # the first stays centred on the pushed block
+    c_low, _, c_high, _ = checker.shadow_box("A", c_iv.center, c_iv.half)
+    assert c_low < 6.088 + half < c_high  # ... and clips C
+    (clear,) = [x for x in centres if x != 6.088]
+    missed = clear + half <= c_low
+    covered = clear - half <= c_low and clear + half >= c_high
+    assert missed or covered
+    assert abs(clear - 6.088) <= half - 0.1
+    # Nothing ahead to clip: one position only.
+    assert centres_pushing_d_down(IntervalBelief((("B", d_iv),))) == [6.088]
+    # Off by default (particle semantics simulate clipped contacts): one position only.
+    assert centres_pushing_d_down(state, ActionGenerator(p, checker)) == [6.088]
