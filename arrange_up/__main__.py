@@ -1,5 +1,5 @@
 """``python -m arrange_up`` runs the ``arrange-up`` command."""
 
-from arrange_up.cli.commands import main
+from arrange_up.cli import main
 
 main()

@@ -10,7 +10,7 @@ import textwrap
 import pytest
 from click.testing import CliRunner
 
-from arrange_up.cli.commands import main
+from arrange_up.cli import main
 
 BAD = textwrap.dedent(
     """\

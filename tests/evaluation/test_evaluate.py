@@ -11,7 +11,7 @@ import sys
 import pytest
 from click.testing import CliRunner
 
-from arrange_up.cli.commands import main
+from arrange_up.cli import main
 from arrange_up.evaluation.evaluate import (
     ACTION_FAILED,
     GOAL_MISSED,

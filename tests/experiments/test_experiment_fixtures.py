@@ -9,7 +9,7 @@ from click.testing import CliRunner
 
 import arrange_up.evaluation.evaluate
 import arrange_up.repair.fixture_repair
-from arrange_up.cli.commands import main
+from arrange_up.cli import main
 from arrange_up.experiments.fixtures import (
     FAILURE_KINDS,
     FIXTURE_FIELDS,

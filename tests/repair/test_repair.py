@@ -13,7 +13,7 @@ import math
 import pytest
 from click.testing import CliRunner
 
-from arrange_up.cli.commands import main
+from arrange_up.cli import main
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic

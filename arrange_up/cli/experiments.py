@@ -1,0 +1,362 @@
+"""The ``experiment`` commands: the thesis's experiments, resumable, as CSV and PNG."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import click
+
+from arrange_up.cli.shared import (
+    EXIT_NEGATIVE,
+    backend_choice,
+    check_semantics,
+    comma_integers,
+    comma_separated,
+    fail,
+    library_default,
+    load_problem,
+    parallel_options,
+)
+from arrange_up.experiments.fixtures import (
+    CSV_NAME,
+    DEFAULT_PARTICLES,
+    DEFAULT_PROBLEMS,
+    StaleResultsError,
+    fixture_experiment,
+    markdown_table,
+    read_rows,
+    select_rows,
+    summarize,
+)
+from arrange_up.experiments.planning import (
+    Planner,
+    default_planners,
+    search_table,
+    transition_comparison,
+)
+from arrange_up.parallel import BackendUnavailableError
+from arrange_up.repair.fixture_repair import METHODS
+from arrange_up.transitions import available
+
+#: The semantics whose planners --particles makes; --semantics names the others.
+_PARTICLE_PLANNERS = ("deterministic", "particles")
+
+
+@click.group()
+def experiment() -> None:
+    """Reproduce the thesis's experiments (CSV of every measurement + PNG summary).
+
+    Results are appended as they are measured; re-running the same command resumes, skipping
+    what the CSV already holds.
+    """
+
+
+def _say(message: str) -> None:
+    click.echo(f"[{time.strftime('%H:%M:%S')}] {message}", err=True)
+
+
+def _refuse_bad_problems(names: list[str]) -> None:
+    """Exit 2 on the first problem that does not load, before hours of work."""
+    for name in names:
+        load_problem(name)
+
+
+@experiment.command("transition-comparison")
+@click.option(
+    "--problems",
+    default=comma_separated(library_default(transition_comparison, "problems")),
+    show_default=True,
+    help="Comma-separated problems.",
+)
+@click.option(
+    "--particles",
+    "particle_counts",
+    default=comma_separated(library_default(default_planners, "particle_counts")),
+    show_default=True,
+    help="Comma-separated particle counts of the particle planners.",
+)
+@click.option(
+    "--semantics",
+    "extra",
+    default=None,
+    help="Comma-separated further semantics (default: every other registered one).",
+)
+@click.option(
+    "--runs",
+    type=click.IntRange(1, 1000),
+    default=library_default(transition_comparison, "runs"),
+    show_default=True,
+    help="Planning runs (seeds 0..R-1) per problem and planner.",
+)
+@click.option(
+    "--rollouts",
+    type=click.IntRange(0, 1_000_000),
+    default=library_default(transition_comparison, "rollouts"),
+    show_default=True,
+    help="Noisy rollouts per plan (0: no evaluation).",
+)
+@click.option(
+    "--max-nodes",
+    type=click.IntRange(1, None),
+    default=library_default(transition_comparison, "max_nodes"),
+    show_default=True,
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Planning time limit per run, seconds.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(1, 256),
+    default=None,
+    help="Worker processes (default: all cores).",
+)
+@click.option(
+    "--output-dir", type=click.Path(file_okay=False), default="results", show_default=True
+)
+def experiment_transition_comparison(
+    problems: str,
+    particle_counts: str,
+    extra: str | None,
+    runs: int,
+    rollouts: int,
+    max_nodes: int,
+    timeout: float | None,
+    workers: int | None,
+    output_dir: str,
+) -> None:
+    """Figures 3-6 and 3-7: planning time and reliability of each belief transition."""
+    counts = comma_integers("--particles", particle_counts)
+    planners = [p for p in default_planners(counts) if p.semantics in _PARTICLE_PLANNERS]
+    names = extra.split(",") if extra else [n for n in available() if n not in _PARTICLE_PLANNERS]
+    for name in names:
+        check_semantics(name)
+        planners.append(Planner(name, name, 1))
+    _refuse_bad_problems(problems.split(","))
+    path = transition_comparison(
+        Path(output_dir),
+        problems=problems.split(","),
+        planners=planners,
+        runs=runs,
+        rollouts=rollouts,
+        max_nodes=max_nodes,
+        timeout=timeout,
+        workers=workers,
+        progress=_say,
+    )
+    click.echo(f"wrote {path} and {path.with_suffix('.png')}")
+
+
+@experiment.command("search-table")
+@click.option(
+    "--problems",
+    default=comma_separated(library_default(search_table, "problems")),
+    show_default=True,
+    help="Comma-separated problems.",
+)
+@click.option(
+    "--semantics",
+    default=None,
+    help="Belief transition (default: cbst when available, as in the thesis; else deterministic).",
+)
+@click.option(
+    "--particles",
+    type=click.IntRange(1, 100_000),
+    default=library_default(search_table, "particles"),
+    show_default=True,
+)
+@click.option(
+    "--max-nodes",
+    type=click.IntRange(1, None),
+    default=library_default(search_table, "max_nodes"),
+    show_default=True,
+)
+@click.option(
+    "--weight",
+    type=click.FloatRange(0, None),
+    default=library_default(search_table, "weight"),
+    show_default=True,
+    help="1 = A*, as in the thesis's table.",
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Time limit per search, seconds.",
+)
+@click.option(
+    "--output-dir", type=click.Path(file_okay=False), default="results", show_default=True
+)
+def experiment_search_table(
+    problems: str,
+    semantics: str | None,
+    particles: int,
+    max_nodes: int,
+    weight: float,
+    timeout: float | None,
+    output_dir: str,
+) -> None:
+    """Table 3.1: nodes expanded and plan cost for each heuristic, with and without
+    domination."""
+    if semantics is None:
+        semantics = "cbst" if "cbst" in available() else "deterministic"
+    check_semantics(semantics)
+    _refuse_bad_problems(problems.split(","))
+    path = search_table(
+        Path(output_dir),
+        problems=problems.split(","),
+        semantics=semantics,
+        particles=particles,
+        max_nodes=max_nodes,
+        weight=weight,
+        timeout=timeout,
+        progress=_say,
+    )
+    click.echo(f"wrote {path} and {path.parent / f'search-table-{semantics}.png'}")
+
+
+@experiment.command("fixtures")
+@click.option(
+    "--problems",
+    default=comma_separated(DEFAULT_PROBLEMS),
+    show_default=True,
+    help="Comma-separated problems (names or .yaml paths).",
+)
+@click.option(
+    "--plans",
+    type=click.IntRange(1, 1000),
+    default=library_default(fixture_experiment, "plans"),
+    show_default=True,
+    help="Distinct nominal plans per problem (thesis: 20).",
+)
+@click.option(
+    "--particles",
+    "particle_counts",
+    default=comma_separated(DEFAULT_PARTICLES),
+    show_default=True,
+    help="Comma-separated particle counts; every nominal plan is repaired once per count.",
+)
+@click.option(
+    "--rollouts",
+    type=click.IntRange(0, 1_000_000),
+    default=library_default(fixture_experiment, "rollouts"),
+    show_default=True,
+    help="Noisy rollouts per nominal and per repaired plan (0: no evaluation).",
+)
+@click.option(
+    "--seed",
+    type=click.IntRange(0, None),
+    default=0,
+    show_default=True,
+    help="Seeds the nominal plans, the repairs' particles and noise, and the rollouts.",
+)
+@click.option(
+    "--method",
+    type=click.Choice(METHODS),
+    default=library_default(fixture_experiment, "method"),
+    show_default=True,
+    help="Candidate placements of the repair (see 'arrange-up repair --help').",
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Time limit per repair, seconds (the thesis allowed 24 hours); a repair that reaches "
+    "it is recorded with status 'timeout'.",
+)
+@parallel_options("rollouts")
+@click.option(
+    "--output-dir",
+    type=click.Path(file_okay=False),
+    default="results",
+    show_default=True,
+    help="Where fixtures.csv and the PNGs go; a fixtures.csv already there is resumed.",
+)
+def experiment_fixtures(
+    problems: str,
+    plans: int,
+    particle_counts: str,
+    rollouts: int,
+    seed: int,
+    method: str,
+    timeout: float | None,
+    workers: int | None,
+    backend: str | None,
+    scheduler: str | None,
+    output_dir: str,
+) -> None:
+    """Figures 4-14 to 4-25: reliability of nominal plans before and after fixture repair.
+
+    For each problem: --plans distinct nominal (deterministic) plans; each is evaluated over
+    --rollouts noisy rollouts, then repaired once per --particles count (arrange-up repair)
+    and the repaired plan evaluated on the same rollouts. --workers processes run both the
+    repairs and the rollouts (on 2 cores, --workers 1 was the faster: with up to 150
+    particles a repair's process pool costs more than it saves); --backend/--scheduler apply
+    to the rollouts only.
+
+    \b
+    Writes into --output-dir:
+      fixtures.csv             one row per measurement: the nominal plan, or one repair
+      fixtures-overview.png    mean reliability, nominal vs repaired (Figure 4-14)
+      fixtures-PROBLEM.png     reliability, repair time and plan length vs particles
+                               (Figures 4-16 to 4-25)
+    and prints a Markdown summary table on stdout; progress lines go to stderr.
+
+    Nothing is skipped silently: a plan the deterministic planner cannot find is a row with
+    status 'no-plan', a repair that fails or times out is a row with that status and its
+    reason (and no evaluation).
+
+    Rows are written as they are measured, and rerunning resumes: rows already in the CSV
+    (same problem, seed, plan, particles, method) are not measured again, whatever
+    --rollouts. So you can interrupt a run, or grow --plans and --particles later.
+
+    \b
+    Examples:
+      arrange-up experiment fixtures --problems tz-mating --plans 2 --particles 10,40 \\
+          --rollouts 100 --output-dir tz-quick
+      arrange-up experiment fixtures --plans 5 --particles 10,40,150 --workers 1 \\
+          --output-dir docs/results      # docs/results.md: ~32 min on 2 cores
+      arrange-up experiment fixtures --workers 1   # thesis scale: ~2-3 h on 2 cores (est.)
+
+    Exit status: 0 the sweep ran (whatever the results), 1 interrupted, 2 bad input or a CSV
+    measured on other nominal plans.
+    """
+    backend = backend_choice(backend, scheduler)
+    counts = comma_integers("--particles", particle_counts)
+    if not counts or any(n < 1 for n in counts):
+        fail(f"--particles: expected positive integers, got {particle_counts!r}")
+    names = [n.strip() for n in problems.split(",") if n.strip()]
+    if not names:
+        fail("--problems: expected at least one problem")
+    _refuse_bad_problems(names)
+    try:
+        path = fixture_experiment(
+            Path(output_dir),
+            problems=names,
+            plans=plans,
+            particles=counts,
+            rollouts=rollouts,
+            seed=seed,
+            method=method,
+            timeout=timeout,
+            workers=workers,
+            backend=backend,
+            scheduler=scheduler,
+            progress=_say,
+        )
+    except KeyboardInterrupt:
+        fail(
+            f"interrupted; the rows measured so far are in {Path(output_dir) / CSV_NAME}: "
+            "run again to resume",
+            EXIT_NEGATIVE,
+        )
+    except (StaleResultsError, BackendUnavailableError, ValueError) as error:
+        fail(str(error))
+    rows = select_rows(
+        read_rows(path), problems=names, plans=plans, particles=counts, seed=seed, method=method
+    )
+    click.echo(markdown_table(summarize(rows)))
+    click.echo(f"wrote {path} and {path.parent / 'fixtures-*.png'}")

@@ -1,0 +1,191 @@
+"""The ``plan`` command: belief-space search for a conformant plan."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+from rich.progress import TextColumn
+
+from arrange_up.cli.shared import (
+    EXIT_NEGATIVE,
+    actions_table,
+    check_semantics,
+    document_summary,
+    echo_json,
+    fail,
+    library_default,
+    load_problem,
+    terminal_progress,
+)
+from arrange_up.io.planfile import plan_document, write_json_atomic
+from arrange_up.parallel import available_cores
+from arrange_up.planning.heuristics import HEURISTICS
+from arrange_up.planning.planner import DEFAULT_MAX_NODES, DEFAULT_WEIGHT
+from arrange_up.planning.planner import plan as run_plan
+
+
+def _status_line(stats: dict[str, Any]) -> str:
+    """The live search status shown on a terminal."""
+    best = stats.get("best_h")
+    return (
+        f"expanded {stats['expanded']:>6}  generated {stats['generated']:>7}  "
+        f"simulated {stats['transitions_simulated']:>8}  best h "
+        f"{'-' if best is None else f'{best:g}'}  {stats['elapsed']:6.1f} s"
+    )
+
+
+@click.command()
+@click.argument("problem")
+@click.option(
+    "--semantics",
+    default=library_default(run_plan, "semantics"),
+    show_default=True,
+    help="Belief transition: deterministic (nominal, one particle, no noise), particles "
+    "(thesis §3.1: simulate every particle) or cbst (thesis §3.2: interval beliefs and the "
+    "learned push model; square blocks and the 2.5 x 0.15 in paddle).",
+)
+@click.option(
+    "--particles",
+    type=click.IntRange(1, 100_000),
+    default=library_default(run_plan, "particles"),
+    show_default=True,
+    help="Particles per belief (particle semantics).",
+)
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="Seed for initial particles and noise: equal seeds give equal plans.",
+)
+@click.option(
+    "--max-nodes",
+    type=click.IntRange(1, None),
+    default=None,
+    help=f"Node limit (default: the problem's planning.max_nodes, else {DEFAULT_MAX_NODES}).",
+)
+@click.option(
+    "--timeout",
+    type=click.FloatRange(0, None, min_open=True),
+    default=None,
+    help="Give up after this many seconds.",
+)
+@click.option(
+    "--heuristic",
+    default=library_default(run_plan, "heuristic"),
+    show_default=True,
+    type=click.Choice(HEURISTICS),
+    help="Search heuristic (thesis §2.2.2, §3.2).",
+)
+@click.option(
+    "--weight",
+    type=click.FloatRange(0, None),
+    default=DEFAULT_WEIGHT,
+    show_default=True,
+    help="Weighted A*: f = g + weight * h (1 = A*).",
+)
+@click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
+@click.option(
+    "--workers",
+    type=click.IntRange(1, 256),
+    default=None,
+    help="Processes simulating particles (default: all cores; 1 for deterministic).",
+)
+@click.option(
+    "--output",
+    "-o",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write the plan file (JSON, documented in docs/plan-format.md).",
+)
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print a machine-readable summary (JSON) on stdout instead of the table.",
+)
+def plan(
+    problem: str,
+    semantics: str,
+    particles: int,
+    seed: int,
+    max_nodes: int | None,
+    timeout: float | None,
+    heuristic: str,
+    weight: float,
+    no_dominance: bool,
+    workers: int | None,
+    output: str | None,
+    as_json: bool,
+) -> None:
+    """Search belief space for a conformant plan for PROBLEM.
+
+    \b
+    Examples:
+      arrange-up plan blocks-2 --semantics deterministic
+      arrange-up plan blocks-4 --particles 50 --seed 1 --output blocks-4.plan.json
+      arrange-up plan my-problem.yaml --timeout 300 --json
+
+    Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted),
+    2 bad input.
+    """
+    check_semantics(semantics)
+    loaded = load_problem(problem)
+    if workers is None:
+        workers = 1 if semantics == "deterministic" else available_cores()
+    try:
+        with terminal_progress(TextColumn("{task.description}")) as display:
+            update = None
+            if display is not None:
+                task = display.add_task("starting…", total=None)
+
+                def update(stats: dict[str, Any]) -> None:
+                    display.update(task, description=_status_line(stats))
+
+            result = run_plan(
+                loaded,
+                semantics=semantics,
+                particles=particles,
+                seed=seed,
+                max_nodes=max_nodes,
+                timeout=timeout,
+                heuristic=heuristic,
+                weight=weight,
+                dominance=not no_dominance,
+                workers=workers,
+                progress=update,
+            )
+    except KeyboardInterrupt:
+        fail("interrupted; no plan was written", EXIT_NEGATIVE)
+    document = plan_document(
+        loaded,
+        result.actions,
+        status=result.status,
+        semantics=result.semantics,
+        seed=seed,
+        search=result.stats,
+        extra={"particles": result.particles},
+    )
+    if output:
+        write_json_atomic(Path(output), document)
+    if as_json:
+        plan_length = len(result.actions) if result.actions is not None else None
+        echo_json(document_summary(document, output, plan_length=plan_length))
+    else:
+        stats = result.stats
+        click.echo(
+            f"{loaded.name}: {result.status} ({result.semantics}, "
+            f"{result.particles} particle{'s' if result.particles != 1 else ''}, "
+            f"seed {seed}) in {stats['elapsed']:.1f} s: expanded {stats['expanded']}, "
+            f"generated {stats['generated']}, "
+            f"transitions simulated {stats['transitions_simulated']}"
+        )
+        if result.actions is not None:
+            click.echo(actions_table(loaded, result.actions))
+        if output:
+            click.echo(f"wrote {output}")
+    if not result.solved:
+        sys.exit(EXIT_NEGATIVE)

@@ -1,0 +1,177 @@
+"""What every command of ``arrange-up`` shares: exit statuses, the clean failure, loading a
+problem or a plan file, the semantics check, the parallel options, the progress display, JSON
+and table output, and the library defaults the options show.
+
+Exit status: 0 success; 1 the job ran but its answer is negative (e.g. a problem file has
+errors under ``check``); 2 bad input (unreadable or invalid problem, unknown domain, bad option).
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import sys
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any, NoReturn
+
+import click
+from rich.console import Console
+from rich.progress import Progress, ProgressColumn
+
+from arrange_up.io.domains import UnknownDomainError, load
+from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_mismatch, read_plan
+from arrange_up.model.errors import ProblemFormatError
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action
+from arrange_up.parallel import BACKENDS
+from arrange_up.transitions import available
+
+EXIT_NEGATIVE = 1
+EXIT_BAD_INPUT = 2
+
+
+def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
+    """Print ``arrange-up: message`` on stderr and exit with ``code`` (default: bad input)."""
+    click.echo(f"arrange-up: {message}", err=True)
+    sys.exit(code)
+
+
+def library_default(function: Callable[..., Any], parameter: str) -> Any:
+    """The default of ``function``'s ``parameter``: an option whose default is the library's
+    shows and uses that one, so the two cannot drift apart."""
+    return inspect.signature(function).parameters[parameter].default
+
+
+def comma_separated(values: Sequence[Any]) -> str:
+    """``values`` as a comma-separated option value (the defaults of list options)."""
+    return ",".join(str(value) for value in values)
+
+
+def comma_integers(option: str, text: str) -> list[int]:
+    """The integers of a comma-separated option value (blank items skipped), exit 2 otherwise."""
+    try:
+        return [int(item) for item in text.split(",") if item.strip()]
+    except ValueError:
+        fail(f"{option}: expected comma-separated integers, got {text!r}")
+
+
+def load_problem(problem: str) -> ArrangementProblem:
+    """Resolve and load a problem, turning every refusal into a clean message and exit 2."""
+    try:
+        return load(problem)
+    except UnknownDomainError as error:
+        fail(str(error))
+    except ProblemFormatError as error:
+        click.echo(str(error), err=True)
+        n = sum(1 for d in error.diagnostics if d.severity == "error")
+        fail(f"{n} error{'s' if n != 1 else ''}; nothing was done")
+
+
+def read_plan_file(
+    problem: ArrangementProblem, plan_file: str, *, warn_mismatch: bool
+) -> tuple[tuple[Action, ...], dict[str, Any]]:
+    """Read a plan file for ``problem`` as (actions, document): a clean message and exit 2 on a
+    bad file; with ``warn_mismatch``, a warning when the plan was made for other problem
+    content."""
+    try:
+        actions, document = read_plan(plan_file, problem)
+    except PlanFileError as error:
+        fail(str(error))
+    mismatch = plan_problem_mismatch(document, problem) if warn_mismatch else None
+    if mismatch:
+        click.echo(f"arrange-up: warning: {plan_file}: {mismatch}; using it anyway", err=True)
+    return actions, document
+
+
+def check_semantics(name: str) -> None:
+    """Exit 2 naming the registered semantics unless ``name`` is one."""
+    if name not in available():
+        fail(f"--semantics: unknown semantics {name!r}; expected one of {', '.join(available())}")
+
+
+def parallel_options(what: str) -> Callable[[Any], Any]:
+    """The --workers, --backend and --scheduler options of commands that run batches of
+    independent simulations (``what``: rollouts, examples, ...) on local processes or Dask."""
+    options = (
+        click.option(
+            "--workers",
+            type=click.IntRange(1, 1024),
+            default=None,
+            help="Worker processes (default: all cores; 1 runs in this process).",
+        ),
+        click.option(
+            "--backend",
+            type=click.Choice(BACKENDS),
+            default=None,
+            help=f"Where the {what} run: local processes (default) or a Dask cluster.",
+        ),
+        click.option(
+            "--scheduler",
+            metavar="ADDRESS",
+            default=None,
+            help="Address of a running Dask scheduler (implies --backend dask); "
+            "without it the dask backend starts a local cluster of "
+            "--workers processes.",
+        ),
+    )
+
+    def decorate(command: Any) -> Any:
+        for option in reversed(options):
+            command = option(command)
+        return command
+
+    return decorate
+
+
+def backend_choice(backend: str | None, scheduler: str | None) -> str:
+    """The backend to use: a scheduler address implies dask and contradicts local."""
+    if scheduler is not None and backend == "local":
+        fail("--scheduler: a scheduler address needs --backend dask")
+    return backend or ("dask" if scheduler is not None else "local")
+
+
+@contextmanager
+def terminal_progress(*columns: str | ProgressColumn) -> Iterator[Progress | None]:
+    """A transient rich progress display with ``columns`` on stderr while the block runs, or
+    None when stderr is not a terminal (nothing is drawn into pipes, files or tests). The
+    display is gone when the block exits, so messages printed after it (e.g. on an interrupt)
+    are not overdrawn."""
+    if not sys.stderr.isatty():
+        yield None
+        return
+    with Progress(*columns, console=Console(stderr=True), transient=True) as display:
+        yield display
+
+
+def echo_json(data: Any) -> None:
+    """Print ``data`` as indented JSON on stdout (the --json summaries)."""
+    click.echo(json.dumps(data, indent=2))
+
+
+def document_summary(document: dict[str, Any], output: str | None, **extra: Any) -> dict[str, Any]:
+    """The --json summary of a plan document: its fields but the actions, then ``extra``,
+    then the actions and the file written (``output``, or None)."""
+    summary = {k: v for k, v in document.items() if k != "actions"}
+    summary.update(extra)
+    summary["actions"] = document.get("actions")
+    summary["output"] = output
+    return summary
+
+
+def actions_table(problem: ArrangementProblem, actions: Sequence[Action]) -> str:
+    """The plan as an aligned text table in the problem's units."""
+    units = problem.units
+    lines = [
+        f"{'#':>3}  {'action':<6} {'object':<12} {'x':>8} {'y':>8} {'theta':>8} {'distance':>9}",
+        f"{'':>3}  {'':<6} {'':<12} {units.length:>8} {units.length:>8} "
+        f"{units.angle:>8} {units.length:>9}",
+    ]
+    for i, action in enumerate(actions, 1):
+        data = action_to_json(action, units)
+        pose = data.get("pose")
+        xs = [f"{v:8.3f}" for v in pose] if pose else [f"{'':>8}"] * 3
+        dist = f"{data['distance']:9.3f}" if "distance" in data else ""
+        who = data.get("object") or data.get("manipulator")
+        lines.append(f"{i:>3}  {data['type']:<6} {who:<12} {' '.join(xs)} {dist}")
+    return "\n".join(lines)
