@@ -93,8 +93,3 @@ def test_version():
     result = CliRunner().invoke(main, ["--version"])
     assert result.exit_code == 0 and result.output.startswith("arrange-up, version ")
 
-
-def test_the_former_module_still_exports_main():
-    from arrange_up.cli.commands import main as former
-
-    assert former is main
