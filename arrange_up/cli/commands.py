@@ -259,12 +259,12 @@ def show(
     actions, document = _read_plan_for(loaded, plan_file)
     if heatmap_step is not None:
         from arrange_up.figures.render import write_heatmap
-        from arrange_up.repair.fixture_repair import step_scores
-        from arrange_up.transitions.particles import default_workers
+        from arrange_up.parallel import available_cores
+        from arrange_up.repair import step_scores
 
         try:
             scores = step_scores(
-                loaded, actions, heatmap_step, document=document, workers=default_workers()
+                loaded, actions, heatmap_step, document=document, workers=available_cores()
             )
         except ValueError as error:
             _fail(f"--heatmap: {error}")
@@ -445,9 +445,9 @@ def plan(
         )
     loaded = _load(problem)
     if workers is None:
-        from arrange_up.transitions.particles import default_workers
+        from arrange_up.parallel import available_cores
 
-        workers = 1 if semantics == "deterministic" else default_workers()
+        workers = 1 if semantics == "deterministic" else available_cores()
     update, live = _progress_printer(True)
     try:
         result = run_plan(
@@ -838,7 +838,7 @@ def repair(
     import json
 
     from arrange_up.io.planfile import PlanFileError, read_plan, write_json_atomic
-    from arrange_up.repair.fixture_repair import nominal_plans, repair_plan
+    from arrange_up.repair import nominal_plans, repair_plan
 
     loaded = _load(problem)
     if plan_file is not None:
@@ -852,9 +852,9 @@ def repair(
             _fail("the deterministic planner found no nominal plan to repair", EXIT_NEGATIVE)
         nominal = found[0]
     if workers is None:
-        from arrange_up.transitions.particles import default_workers
+        from arrange_up.parallel import available_cores
 
-        workers = default_workers()
+        workers = available_cores()
     interactive = sys.stderr.isatty()
 
     def progress(info: dict) -> None:

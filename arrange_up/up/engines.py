@@ -692,7 +692,7 @@ def _repair(engine: Any, problem: Any, plan: Any) -> Any:
     from unified_planning.engines import LogLevel, LogMessage, PlanGenerationResult
     from unified_planning.engines import PlanGenerationResultStatus as Status
 
-    from arrange_up.repair.fixture_repair import repair_plan
+    from arrange_up.repair import repair_plan
 
     def result(status: Any, plan: Any = None, logs: Any = (), metrics: Any = None) -> Any:
         return PlanGenerationResult(
