@@ -94,9 +94,7 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
 
 def test_a_problem_without_nominal_plan_is_recorded_not_skipped(tmp_path, monkeypatch):
     # As if the deterministic planner found no plan for down-push.
-    monkeypatch.setattr(
-        "arrange_up.repair.nominal_plans", lambda *_args, **_kwargs: []
-    )
+    monkeypatch.setattr("arrange_up.repair.nominal_plans", lambda *_args, **_kwargs: [])
     path = fixture_experiment(tmp_path, problems=("down-push",), **{**TINY, "plans": 2})
     table = rows(path)
     assert [(r["plan"], r["stage"], r["status"]) for r in table] == [
