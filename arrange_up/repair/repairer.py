@@ -106,6 +106,7 @@ from arrange_up.repair.candidates import (
     Key,
     Outcome,
     StepScores,
+    Swath,
     candidate,
     choose,
     clear_approach,
@@ -505,120 +506,57 @@ class Repairer:
         started = time.monotonic()
         sims_before = self.simulations
 
-        approach, backoff = clear_approach(self.problem, self.checker, self.intervals(belief), push)
+        def report(phase: str, candidates: int) -> None:
+            if progress is not None:
+                progress(
+                    {
+                        "step": step + 1,
+                        "steps": steps,
+                        "kind": "push",
+                        "phase": phase,
+                        "candidates": candidates,
+                        "elapsed": time.monotonic() - started,
+                    }
+                )
 
-        def pushed(m: float) -> Push:
-            return Push(push.manipulator, approach, round_pose_value(push.distance * m + backoff))
-
+        problem = _OneStepProblem(self, belief, step, push, nominal_next)
         # 1. swath from the no-fixture push at the selection multiplier (every particle)
-        raw, failure = self.raw_poses(belief, pushed(SELECTION_MULTIPLIER), step)
-        swaths = part_swaths(self.checker, self.parts, belief, raw)
-        cache: dict[Key, Outcome] = {}
-        if failure:
-            cache[(None, None, SELECTION_MULTIPLIER)] = Outcome(None, math.inf, failure)
-        else:
-            states = tuple(
-                self.frame.canonical(WorldState.from_mapping(self.problem, poses)) for poses in raw
-            )
-            bare = ParticleBelief(states)
-            cache[(None, None, SELECTION_MULTIPLIER)] = Outcome(
-                bare, self.distance(bare, nominal_next)
-            )
-        grid = grid_placements(
-            self.problem, self.checker, self.intervals(belief), belief.names(), pushed(1.0)
-        )
-        if self.method == "enhanced":
-            grid = [
-                g
-                for g in grid
-                if any(
-                    geometry.boxes_overlap(footprint(self.checker, g[0], g[1]), box)
-                    for _, box in swaths
-                )
-            ]
+        swaths = problem.swaths()
+        grid = problem.grid(swaths)
         allowed = [g for g in grid if g[2]]
-        if progress is not None:
-            progress(
-                {
-                    "step": step + 1,
-                    "steps": steps,
-                    "kind": "push",
-                    "phase": "placements",
-                    "candidates": len(allowed) + 1,
-                    "elapsed": time.monotonic() - started,
-                }
-            )
-
-        def evaluate(keys: list[Key]) -> None:
-            """Simulate the candidates of ``keys`` not yet in ``cache`` (no fixture first)."""
-            todo = [key for key in keys if key not in cache]
-            bare = [key for key in todo if key[0] is None]
-            if bare:
-                results = self.pushes(
-                    [(belief, pushed(m)) for _, _, m in bare], step, distance_to=nominal_next
-                )
-                cache.update(zip(bare, results, strict=True))
-            batch, batch_keys = [], []
-            for key in todo:
-                fixture, pose, m = key
-                if fixture is None or pose is None:
-                    continue
-                placed = self.place(belief, step, Place(fixture, pose))
-                affected = self.semantics.affected_objects(self.intervals(placed), pushed(m))
-                if fixture not in affected:
-                    base = cache[(None, None, m)]
-                    cache[key] = Outcome(base.belief, base.distance, base.reason, reachable=False)
-                    continue
-                batch.append((placed, pushed(m)))
-                batch_keys.append(key)
-            if batch:
-                results = self.pushes(batch, step)
-                for key, result in zip(batch_keys, results, strict=True):
-                    if result.belief is not None:
-                        after = self.pick(result.belief, Pick(key[0]))  # type: ignore[arg-type]
-                        result = Outcome(after, self.distance(after, nominal_next))
-                    cache[key] = result
-
+        report("placements", len(allowed) + 1)
         # 2-3. placements at the selection multiplier (falling back to smaller ones)
         selection = SELECTION_MULTIPLIER
         for m in sorted(MULTIPLIERS, reverse=True):
             selection = m
             keys = [(None, None, m)] + [(f, p, m) for f, p, _ in allowed]
-            evaluate(keys)
-            if any(cache[key].belief is not None for key in keys):
+            problem.evaluate(keys)
+            if any(problem.outcomes[key].belief is not None for key in keys):
                 break
         placement_candidates = stage_candidates(
-            [(None, None, True)] + grid, selection, cache, pushed
+            [(None, None, True)] + grid, selection, problem.outcomes, problem.pushed
         )
         # 4. multipliers for the best few placements and no fixture
         ranked = sorted(
             (c for c in placement_candidates if c.valid and c.fixture is not None and c.reachable),
             key=lambda c: c.distance,
         )[:REFINE]
-        if progress is not None:
-            progress(
-                {
-                    "step": step + 1,
-                    "steps": steps,
-                    "kind": "push",
-                    "phase": "refine",
-                    "candidates": (len(ranked) + 1) * len(MULTIPLIERS),
-                    "elapsed": time.monotonic() - started,
-                }
-            )
+        report("refine", (len(ranked) + 1) * len(MULTIPLIERS))
         refine_keys = [(None, None, m) for m in MULTIPLIERS] + [
             (c.fixture, c.pose, m) for c in ranked for m in MULTIPLIERS
         ]
-        evaluate(refine_keys)
-        refined = normalise([candidate(key, cache[key], pushed(key[2])) for key in refine_keys])
+        problem.evaluate(refine_keys)
+        refined = normalise(
+            [candidate(key, problem.outcomes[key], problem.pushed(key[2])) for key in refine_keys]
+        )
         best = choose([c for c in refined if c.valid])
         after = None
         if best is not None:
-            after = cache[(best.fixture, best.pose, best.multiplier)].belief
+            after = problem.outcomes[(best.fixture, best.pose, best.multiplier)].belief
         return StepScores(
             step=step,
             push=push,
-            backoff=backoff,
+            backoff=problem.backoff,
             belief=belief,
             nominal_state=state,
             nominal_next=nominal_next,
@@ -632,3 +570,99 @@ class Repairer:
             elapsed=time.monotonic() - started,
             after=after,
         )
+
+
+class _OneStepProblem:
+    """The one-step fixture problem of one push from one belief: its backed-off push, and
+    every candidate simulated so far (``outcomes``, by key), each simulated once."""
+
+    def __init__(
+        self,
+        repairer: Repairer,
+        belief: ParticleBelief,
+        step: int,
+        push: Push,
+        nominal_next: WorldState,
+    ) -> None:
+        self.repairer = repairer
+        self.belief = belief
+        self.step = step
+        self.push = push
+        self.nominal_next = nominal_next
+        self.approach, self.backoff = clear_approach(
+            repairer.problem, repairer.checker, repairer.intervals(belief), push
+        )
+        self.outcomes: dict[Key, Outcome] = {}
+
+    def pushed(self, multiplier: float) -> Push:
+        """The push from the cleared approach, its distance times ``multiplier`` plus the
+        back-off."""
+        push = self.push
+        distance = round_pose_value(push.distance * multiplier + self.backoff)
+        return Push(push.manipulator, self.approach, distance)
+
+    def swaths(self) -> tuple[Swath, ...]:
+        """The part motion swaths of the no-fixture push at the selection multiplier, whose
+        outcome (on every particle, also when some fail) is kept as that candidate's."""
+        r, belief = self.repairer, self.belief
+        raw, failure = r.raw_poses(belief, self.pushed(SELECTION_MULTIPLIER), self.step)
+        swaths = part_swaths(r.checker, r.parts, belief, raw)
+        key = (None, None, SELECTION_MULTIPLIER)
+        if failure:
+            self.outcomes[key] = Outcome(None, math.inf, failure)
+        else:
+            bare = ParticleBelief(
+                tuple(r.frame.canonical(WorldState.from_mapping(r.problem, p)) for p in raw)
+            )
+            self.outcomes[key] = Outcome(bare, r.distance(bare, self.nominal_next))
+        return swaths
+
+    def grid(self, swaths: tuple[Swath, ...]) -> list[tuple[str, Pose, bool]]:
+        """The placement grid (``(fixture, pose, allowed)``); for the enhanced method only the
+        placements whose footprint meets a swath."""
+        r, belief = self.repairer, self.belief
+        grid = grid_placements(
+            r.problem, r.checker, r.intervals(belief), belief.names(), self.pushed(1.0)
+        )
+        if r.method != "enhanced":
+            return grid
+        return [
+            g
+            for g in grid
+            if any(
+                geometry.boxes_overlap(footprint(r.checker, g[0], g[1]), box) for _, box in swaths
+            )
+        ]
+
+    def evaluate(self, keys: list[Key]) -> None:
+        """Simulate the candidates of ``keys`` not yet simulated (no fixture first)."""
+        r, belief, step, outcomes = self.repairer, self.belief, self.step, self.outcomes
+        todo = [key for key in keys if key not in outcomes]
+        bare = [key for key in todo if key[0] is None]
+        if bare:
+            results = r.pushes(
+                [(belief, self.pushed(m)) for _, _, m in bare],
+                step,
+                distance_to=self.nominal_next,
+            )
+            outcomes.update(zip(bare, results, strict=True))
+        batch, batch_keys = [], []
+        for key in todo:
+            fixture, pose, m = key
+            if fixture is None or pose is None:
+                continue
+            placed = r.place(belief, step, Place(fixture, pose))
+            affected = r.semantics.affected_objects(r.intervals(placed), self.pushed(m))
+            if fixture not in affected:
+                base = outcomes[(None, None, m)]
+                outcomes[key] = Outcome(base.belief, base.distance, base.reason, reachable=False)
+                continue
+            batch.append((placed, self.pushed(m)))
+            batch_keys.append(key)
+        if batch:
+            results = r.pushes(batch, step)
+            for key, result in zip(batch_keys, results, strict=True):
+                if result.belief is not None:
+                    after = r.pick(result.belief, Pick(key[0]))  # type: ignore[arg-type]
+                    result = Outcome(after, r.distance(after, self.nominal_next))
+                outcomes[key] = result

@@ -369,3 +369,36 @@ def test_up_plan_repairer(down_push):
             assert got.distance == pytest.approx(want.distance, abs=1e-6)
     with pytest.raises(ValueError, match="method"):
         PlanRepairer(name="arrange-up-fixtures", params={"method": "clever"})
+
+
+# -- typed results --------------------------------------------------------------------------------
+def test_statuses_are_string_enums_and_statistics_a_dataclass(down_push, down_repair):
+    assert isinstance(down_repair.status, rp.RepairStatus)
+    assert down_repair.status == "solved" and json.dumps(down_repair.status) == '"solved"'
+    assert down_repair.steps[0].status == rp.StepStatus.OK == "ok"
+    assert all(isinstance(c.status, rp.CandidateStatus) for c in down_repair_scores(down_push))
+    stats = down_repair.statistics
+    assert isinstance(stats, rp.RepairStats)
+    assert list(down_repair.stats()) == [
+        "elapsed",
+        "simulations",
+        "steps",
+        "pushes",
+        "fixtures_placed",
+        "nominal_length",
+        "plan_length",
+    ]
+    assert down_repair.document(down_push)["search"] == stats.to_json()
+    assert stats.plan_length == len(down_repair.actions)
+
+
+def down_repair_scores(problem):
+    nominal = rp.nominal_plans(problem, 1, seed=0)[0]
+    return rp.step_scores(problem, nominal, 1, particles=4, seed=3).placements
+
+
+def test_the_former_module_path_still_works():
+    from arrange_up.repair import fixture_repair
+
+    for name in rp.__all__:
+        assert getattr(fixture_repair, name) is getattr(rp, name)
