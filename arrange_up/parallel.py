@@ -23,8 +23,9 @@ Backends
   (:func:`local_executor`, ``joblib.externals.loky.get_reusable_executor``), fed chunk by chunk
   (at most two tasks per worker in flight) and read with ``concurrent.futures.wait``. loky keeps
   one executor per process and hands the same one to every caller that asks with the same
-  arguments, so only the first batch pays the pool's start-up (~60 ms plus about a second for
-  the workers' imports); the particle semantics and fixture repair share it. Idle workers are
+  arguments, so only the first batch pays the pool's start-up (the workers' imports dominate
+  it); the particle semantics (and through it the fixture repair) and the rollouts share it; it
+  is the process's only worker pool. Idle workers are
   reaped after :data:`IDLE_TIMEOUT` seconds and respawned by the next batch. Interrupting a
   batch cancels its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
   executor wrapper cannot take over an executor that ``get_reusable_executor`` created, so
@@ -48,10 +49,12 @@ joblib's and reaps itself).
 from __future__ import annotations
 
 import atexit
+import logging
 import math
 import os
 import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, wait
 from itertools import islice
 from typing import Any, TypeVar
 
@@ -141,15 +144,17 @@ class SerialRunner(Runner):
 
 #: Idle seconds after which loky reaps a pool's workers. It is loky's default on purpose: loky
 #: keeps ONE executor per process and rebuilds it whenever a caller passes other arguments, so
-#: every user of the local pool (the particle semantics, fixture repair, the rollouts) must ask
-#: for it with the same arguments: through :func:`local_executor`, or as
-#: ``get_reusable_executor(max_workers=n)``.
+#: every user of the local pool (the particle semantics, and through it the fixture repair; the
+#: rollouts; the benchmarks) asks for it through :func:`local_executor`, with the same
+#: arguments.
 IDLE_TIMEOUT = 10
 
 
 def local_executor(workers: int) -> Any:
     """The process's shared loky executor with ``workers`` processes (started on first use,
     reused afterwards; resized, not restarted, when the count changes)."""
+    # lazy: joblib's import is a start-up cost (docs/design/repair.md) that commands which
+    # never start a pool must not pay
     from joblib.externals.loky import get_reusable_executor
 
     return get_reusable_executor(max_workers=workers, timeout=IDLE_TIMEOUT)
@@ -168,8 +173,6 @@ class LocalRunner(Runner):
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
     ) -> Iterator[tuple[T, R]]:
-        from concurrent.futures import FIRST_COMPLETED, wait
-
         _check_chunksize(chunksize)
         executor = local_executor(self.workers)
         chunks = _chunks(items, chunksize)
@@ -209,8 +212,6 @@ class DaskRunner(Runner):
         self.scheduler = scheduler
         self._cluster = None
         if scheduler is None:
-            import logging
-
             n = workers or available_cores()
             self._cluster = distributed.LocalCluster(
                 n_workers=n,
@@ -238,7 +239,7 @@ class DaskRunner(Runner):
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
     ) -> Iterator[tuple[T, R]]:
-        from distributed import as_completed
+        from distributed import as_completed  # an optional dependency (see the module doc)
 
         _check_chunksize(chunksize)
         client = self.client
@@ -252,7 +253,7 @@ class DaskRunner(Runner):
             in_flight.add(future)
             return future
 
-        # four tasks per worker in flight hide the scheduler's round trip (~5-10 ms a task)
+        # four tasks per worker in flight hide the scheduler's round trip (docs/design/repair.md)
         queue = as_completed([submit(c) for c in islice(chunks, 4 * self.workers)])
         try:
             for future in queue:

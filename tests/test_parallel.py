@@ -50,16 +50,24 @@ def test_local_runner_yields_every_item_once_and_reuses_its_pool():
     assert second == first  # the same worker processes: no new start-up
 
 
-def test_the_pool_is_shared_with_the_planners_executor():
-    # the particle semantics and fixture repair take loky's executor directly
-    from joblib.externals.loky import get_reusable_executor
+def test_the_pool_is_the_one_the_particle_semantics_use():
+    # one worker pool per process: the runners', and the particle semantics' (the planner's
+    # and, through it, the fixture repair's)
+    from arrange_up.io.domains import load
+    from arrange_up.transitions.particles import ParticleSemantics
 
-    theirs = get_reusable_executor(max_workers=2)
+    semantics = ParticleSemantics(load("blocks-2"), particles=4, workers=2)
+    theirs = semantics._pool()
+    assert theirs is parallel.local_executor(2)
     before = set(theirs.map(_pid, range(8)))
     ours = {pid for _, pid in get_runner("local", workers=2).map(_pid, range(8), chunksize=1)}
-    after = set(get_reusable_executor(max_workers=2).map(_pid, range(8)))
-    assert before == ours == after
-    assert parallel.local_executor(2) is theirs
+    assert before == ours
+
+
+def test_one_core_counter():
+    from arrange_up.transitions import particles
+
+    assert particles.default_workers is parallel.available_cores
 
 
 def test_errors_in_workers_reach_the_caller():

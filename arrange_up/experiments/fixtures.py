@@ -152,8 +152,8 @@ def fixture_experiment(
     """
     from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
     from arrange_up.io.domains import load
-    from arrange_up.repair.fixture_repair import METHODS, nominal_plans
-    from arrange_up.transitions.particles import default_workers
+    from arrange_up.parallel import available_cores
+    from arrange_up.repair import METHODS, nominal_plans
 
     if plans < 1:
         raise ValueError(f"plans must be at least 1, got {plans!r}")
@@ -163,7 +163,7 @@ def fixture_experiment(
         raise ValueError(f"rollouts must be 0 or more, got {rollouts!r}")
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
-    workers = workers or default_workers()
+    workers = workers or available_cores()
     tries = max_tries if max_tries is not None else 10 * max(plans, 20) + 10
     path = Path(output_dir) / CSV_NAME
     existing = _read(path) if path.exists() else []
@@ -351,7 +351,7 @@ def _repair_row(
     digest: str,
 ) -> dict[str, Any]:
     """One repair as a row; the repaired actions ride along under ``_actions`` (not a column)."""
-    from arrange_up.repair.fixture_repair import repair_plan
+    from arrange_up.repair import repair_plan
 
     started = time.perf_counter()
     try:

@@ -93,10 +93,10 @@ def transition_comparison(
     """Run (or resume) the transition comparison; returns the CSV path. See module doc."""
     from arrange_up.evaluation.evaluate import evaluate_plan
     from arrange_up.io.domains import load
+    from arrange_up.parallel import available_cores
     from arrange_up.planning.planner import plan
-    from arrange_up.transitions.particles import default_workers
 
-    workers = workers or default_workers()
+    workers = workers or available_cores()
     planners = list(planners or default_planners())
     path = Path(output_dir) / "transition-comparison.csv"
     done = _done_keys(path, ("problem", "planner", "run"))

@@ -9,6 +9,17 @@ drawn for that action.
 Reproducibility: particle ``i``'s noise for an action is drawn from a generator seeded with
 ``(seed, i, digest(particle state, action))``. It depends on nothing else — not on the search
 order, the worker count or the process — so equal inputs give bit-identical beliefs and plans.
+:meth:`ParticleSemantics.common_noise` is the other noise scheme, keyed by a step number
+alone: *common random numbers*, the same draw for every candidate action compared at a step
+(the fixture repair's, :mod:`arrange_up.repair`).
+
+One propagation, two faces: :meth:`ParticleSemantics.apply` is the planner's transition; the
+batch face below it (:meth:`~ParticleSemantics.place_particles`,
+:meth:`~ParticleSemantics.pick_particles`, :meth:`~ParticleSemantics.push_jobs`,
+:meth:`~ParticleSemantics.simulate_pushes`, :meth:`~ParticleSemantics.moved_particles`) takes
+the noise from its caller and simulates many beliefs' pushes in one batch, serially or on the
+process's one worker pool (:func:`arrange_up.parallel.local_executor`). ``apply`` is built from
+it, and so is the fixture repair's propagation and candidate scoring.
 
 Work sharing: a push can only move what its manipulator can reach, directly or through a
 train of objects. Before simulating, the objects whose belief shadows lie in the conservative
@@ -24,8 +35,10 @@ rely on such an action.
 from __future__ import annotations
 
 import hashlib
-import os
+from collections.abc import Sequence
 from concurrent.futures import Executor
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -37,7 +50,7 @@ from arrange_up.belief.states import (
 )
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import (
     Action,
     ActionNoise,
@@ -49,9 +62,62 @@ from arrange_up.model.world import (
     nominal_initial_state,
     nominal_noise,
 )
+from arrange_up.parallel import available_cores as default_workers  # noqa: F401  (its former name here)
+from arrange_up.parallel import local_executor
+from arrange_up.physics.simulation import StepStatus, simulate
 
 #: Extra reach of a push beyond its commanded distance, and sideways drift allowance (inches).
 SWEEP_MARGIN = 0.3
+
+#: One particle's push to simulate: the state of the objects it may reach, the push, its noise.
+PushJob = tuple[WorldState, Push, ActionNoise]
+
+# Generic place and push actions: the noise draw depends on the action's kind only.
+_ANY_PLACE = Place("-", (0.0, 0.0, 0.0))
+_ANY_PUSH = Push("-", (0.0, 0.0, 0.0), 0.0)
+
+
+class Simulated(NamedTuple):
+    """One particle's simulated push: its status (a :class:`StepStatus` value), the objects it
+    put off the table, and the poses of the simulated objects afterwards (also when it failed)."""
+
+    status: str
+    off_table: tuple[str, ...]
+    poses: tuple[tuple[str, Pose], ...]
+
+    @property
+    def ok(self) -> bool:
+        return self.status == StepStatus.OK
+
+    def reason(self) -> str:
+        """Why the push failed, as a sentence about "a particle's push"."""
+        if self.status == StepStatus.OFF_TABLE:
+            return f"a particle's push put {', '.join(self.off_table)} off the table"
+        if self.status == StepStatus.NOT_AT_REST:
+            return "a particle's push did not come to rest"
+        if self.status == StepStatus.OVERLAP:
+            return "a particle's push started with shapes overlapping"
+        return f"a particle's push failed ({self.status})"
+
+
+@dataclass(frozen=True)
+class PushBatch:
+    """The simulated pushes of one belief's particles (one group of
+    :meth:`ParticleSemantics.simulate_pushes`).
+
+    ``outcomes[i]`` is particle ``i``'s, or ``None`` when it was not simulated (its share of
+    the particles stopped at an earlier failure). ``failure`` is the first failed outcome in
+    the order the shares were simulated (share by share, each in particle order), ``None``
+    when every particle's push succeeded; ``simulated`` counts the simulations run.
+    """
+
+    outcomes: tuple[Simulated | None, ...]
+    failure: Simulated | None
+    simulated: int
+
+    @property
+    def ok(self) -> bool:
+        return self.failure is None
 
 
 class ParticleSemantics:
@@ -72,12 +138,34 @@ class ParticleSemantics:
         self.frame = AngleFrame.of(problem)
         self.checker = CollisionChecker(problem)
         self._executor: Executor | None = None
+        self._common: dict[int, list[tuple[ActionNoise, ActionNoise]]] = {}
 
     # -- noise -------------------------------------------------------------------------------
     def noise(self, index: int, state: WorldState, action: Action) -> ActionNoise:
         digest = hashlib.blake2b(repr((state.poses, action)).encode(), digest_size=8).digest()
         rng = np.random.default_rng([self.seed, index, int.from_bytes(digest, "little")])
         return draw_noise(self.problem, action, rng)
+
+    def common_noise(self, step: int) -> list[tuple[ActionNoise, ActionNoise]]:
+        """Common random numbers: per particle, the ``(place noise, push noise)`` of ``step``.
+
+        Particle ``i`` draws both from ``default_rng([seed, 0xF1C, step, i])``, whatever the
+        state and the action, so every candidate action compared at one step meets the same
+        worlds. Cached per step.
+        """
+        draws = self._common.get(step)
+        if draws is None:
+            draws = []
+            for i in range(self.particles):
+                rng = np.random.default_rng([self.seed, 0xF1C, step, i])
+                draws.append(
+                    (
+                        draw_noise(self.problem, _ANY_PLACE, rng),
+                        draw_noise(self.problem, _ANY_PUSH, rng),
+                    )
+                )
+            self._common[step] = draws
+        return draws
 
     # -- beliefs -----------------------------------------------------------------------------
     def initial_belief(self) -> ParticleBelief:
@@ -87,37 +175,26 @@ class ParticleSemantics:
     def apply(self, belief: ParticleBelief, action: Action) -> ParticleBelief | None:
         if isinstance(action, Push):
             return self._push(belief, action)
-        states = []
-        for i, state in enumerate(belief.particles):
-            poses = state.as_dict()
-            if isinstance(action, Place):
-                offset = self.noise(i, state, action).pose_offset
-                poses[action.obj] = tuple(a + b for a, b in zip(action.pose, offset, strict=True))
-            elif isinstance(action, Pick):
-                poses.pop(action.obj, None)
-            else:
-                raise TypeError(f"not an action: {action!r}")
-            states.append(self.frame.canonical(WorldState.from_mapping(self.problem, poses)))
-        return ParticleBelief(tuple(states))
+        if isinstance(action, Place):
+            offsets = [
+                self.noise(i, state, action).pose_offset for i, state in enumerate(belief.particles)
+            ]
+            return self.place_particles(belief, action, offsets)
+        if isinstance(action, Pick):
+            return self.pick_particles(belief, action)
+        raise TypeError(f"not an action: {action!r}")
 
     def _push(self, belief: ParticleBelief, push: Push) -> ParticleBelief | None:
         affected = self.affected_objects(belief.intervals, push)
         if not affected:
             return belief
-        jobs = []
-        for i, state in enumerate(belief.particles):
-            sub = WorldState(tuple((n, p) for n, p in state.poses if n in affected))
-            jobs.append((sub, push, self.noise(i, state, push)))
-        outcomes = self._simulate_all(jobs)
-        self.simulations += len(jobs)
-        if outcomes is None:
+        noises = [self.noise(i, state, push) for i, state in enumerate(belief.particles)]
+        [batch] = self.simulate_pushes([self.push_jobs(belief, push, affected, noises)])
+        # the planner's statistic counts every particle's push, also those a failure cut short
+        self.simulations += len(belief.particles)
+        if not batch.ok:
             return None
-        states = []
-        for state, moved in zip(belief.particles, outcomes, strict=True):
-            poses = state.as_dict()
-            poses.update(moved)
-            states.append(self.frame.canonical(WorldState.from_mapping(self.problem, poses)))
-        return ParticleBelief(tuple(states))
+        return self.moved_particles(belief, batch.outcomes)
 
     def affected_objects(self, intervals: IntervalBelief, push: Push) -> frozenset[str]:
         """Objects the push may touch, directly or through others (a conservative sweep)."""
@@ -141,27 +218,96 @@ class ParticleSemantics:
                     frontier.append(_widen(geometry.swept_box(box, direction, reach), direction))
         return frozenset(affected)
 
-    # -- simulation --------------------------------------------------------------------------
-    def _simulate_all(self, jobs) -> list[dict] | None:
-        if self.workers > 1 and len(jobs) >= 2 * self.workers:
-            executor = self._pool()
-            chunks = [jobs[k :: self.workers] for k in range(self.workers)]
-            results = list(executor.map(_simulate_chunk, [self.problem] * len(chunks), chunks))
-            if any(r is None for r in results):
-                return None
-            merged: list[dict] = [{}] * len(jobs)
-            for k, chunk_result in enumerate(results):
-                merged[k :: self.workers] = chunk_result
-            return merged
-        return _simulate_chunk(self.problem, jobs)
+    # -- the batch face ----------------------------------------------------------------------
+    def place_particles(
+        self, belief: ParticleBelief, place: Place, offsets: Sequence[Pose]
+    ) -> ParticleBelief:
+        """Every particle with ``place.obj`` at the commanded pose plus its own offset."""
+        states = []
+        for state, offset in zip(belief.particles, offsets, strict=True):
+            poses = state.as_dict()
+            poses[place.obj] = tuple(a + b for a, b in zip(place.pose, offset, strict=True))
+            states.append(self.frame.canonical(WorldState.from_mapping(self.problem, poses)))
+        return ParticleBelief(tuple(states))
+
+    def pick_particles(
+        self, belief: ParticleBelief, pick: Pick, *, canonical: bool = True
+    ) -> ParticleBelief:
+        """Every particle without ``pick.obj``. ``canonical=False`` leaves the other angles as
+        they are instead of wrapping them again (wrapping is not exactly idempotent in floating
+        point, so the two differ in the last bits)."""
+        states = []
+        for state in belief.particles:
+            poses = state.as_dict()
+            poses.pop(pick.obj, None)
+            after = WorldState.from_mapping(self.problem, poses)
+            states.append(self.frame.canonical(after) if canonical else after)
+        return ParticleBelief(tuple(states))
+
+    def push_jobs(
+        self,
+        belief: ParticleBelief,
+        push: Push,
+        affected: frozenset[str],
+        noises: Sequence[ActionNoise],
+    ) -> list[PushJob]:
+        """One job per particle: its ``affected`` objects, ``push``, and its noise."""
+        return [
+            (WorldState(tuple((n, p) for n, p in state.poses if n in affected)), push, noise)
+            for state, noise in zip(belief.particles, noises, strict=True)
+        ]
+
+    def simulate_pushes(
+        self, groups: Sequence[Sequence[PushJob]], *, stop_on_failure: bool = True
+    ) -> list[PushBatch]:
+        """Simulate every group of jobs (one group per belief and push), all in one batch.
+
+        A group of at least ``2 * workers`` jobs is split into ``workers`` interleaved shares;
+        with ``workers > 1`` and more than one share in the batch, the shares run on the
+        process's worker pool, else here. With ``stop_on_failure`` a share stops at its first
+        failure (the group's outcome is a failure anyway). The outcomes do not depend on
+        ``workers``.
+        """
+        tasks: list[tuple[int, range]] = []
+        for g, jobs in enumerate(groups):
+            shares = self.workers if self.workers > 1 and len(jobs) >= 2 * self.workers else 1
+            tasks.extend((g, range(k, len(jobs), shares)) for k in range(shares))
+        chunks = [[groups[g][i] for i in indices] for g, indices in tasks]
+        if self.workers > 1 and len(tasks) > 1:
+            n = len(chunks)
+            results = list(
+                self._pool().map(_simulate_chunk, [self.problem] * n, chunks, [stop_on_failure] * n)
+            )
+        else:
+            results = [_simulate_chunk(self.problem, chunk, stop_on_failure) for chunk in chunks]
+        outcomes: list[list[Simulated | None]] = [[None] * len(jobs) for jobs in groups]
+        failures: list[Simulated | None] = [None] * len(groups)
+        simulated = [0] * len(groups)
+        for (g, indices), result in zip(tasks, results, strict=True):
+            simulated[g] += len(result)
+            for i, outcome in zip(indices, result, strict=False):
+                outcomes[g][i] = outcome
+                if not outcome.ok and failures[g] is None:
+                    failures[g] = outcome
+        return [
+            PushBatch(tuple(outcomes[g]), failures[g], simulated[g]) for g in range(len(groups))
+        ]
+
+    def moved_particles(
+        self, belief: ParticleBelief, outcomes: Sequence[Simulated | None]
+    ) -> ParticleBelief:
+        """``belief`` with every particle's simulated objects at their poses after the push."""
+        states = []
+        for state, outcome in zip(belief.particles, outcomes, strict=True):
+            assert outcome is not None
+            poses = state.as_dict()
+            poses.update(outcome.poses)
+            states.append(self.frame.canonical(WorldState.from_mapping(self.problem, poses)))
+        return ParticleBelief(tuple(states))
 
     def _pool(self) -> Executor:
         if self._executor is None:
-            # loky (joblib's process pool) rather than multiprocessing: it never re-imports the
-            # caller's __main__ (so scripts need no main guard) and reuses its workers.
-            from joblib.externals.loky import get_reusable_executor
-
-            self._executor = get_reusable_executor(max_workers=self.workers)
+            self._executor = local_executor(self.workers)
         return self._executor
 
     def close(self) -> None:
@@ -187,17 +333,17 @@ class DeterministicSemantics(ParticleSemantics):
         return ParticleBelief((self.frame.canonical(nominal_initial_state(self.problem)),))
 
 
-def _simulate_chunk(problem: ArrangementProblem, jobs) -> list[dict] | None:
-    """Simulate pushes; the moved poses of each, or None as soon as one fails."""
-    from arrange_up.physics.simulation import simulate
-
-    results = []
+def _simulate_chunk(
+    problem: ArrangementProblem, jobs: Sequence[PushJob], stop_on_failure: bool
+) -> list[Simulated]:
+    """Simulate pushes in order; with ``stop_on_failure`` the list ends at the first failure."""
+    out = []
     for state, push, noise in jobs:
         outcome = simulate(problem, state, push, noise)
-        if not outcome.ok:
-            return None
-        results.append(outcome.state.as_dict())
-    return results
+        out.append(Simulated(outcome.status.value, outcome.off_table, outcome.state.poses))
+        if stop_on_failure and not outcome.ok:
+            break
+    return out
 
 
 def _widen(box, direction, margin: float = SWEEP_MARGIN):
@@ -206,11 +352,3 @@ def _widen(box, direction, margin: float = SWEEP_MARGIN):
     if direction[0]:
         return (xmin, ymin - margin, xmax, ymax + margin)
     return (xmin - margin, ymin, xmax + margin, ymax)
-
-
-def default_workers() -> int:
-    """Worker processes to use by default: every core the process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not on Linux
-        return os.cpu_count() or 1

@@ -8,7 +8,7 @@ import pytest
 from click.testing import CliRunner
 
 import arrange_up.evaluation.evaluate
-import arrange_up.repair.fixture_repair
+import arrange_up.repair
 from arrange_up.cli import main
 from arrange_up.experiments.fixtures import (
     FAILURE_KINDS,
@@ -36,7 +36,7 @@ def forbid(monkeypatch, *names):
         raise AssertionError("measured again although the CSV holds the row")
 
     if "repair" in names:
-        monkeypatch.setattr(arrange_up.repair.fixture_repair, "repair_plan", refuse)
+        monkeypatch.setattr(arrange_up.repair, "repair_plan", refuse)
     if "evaluate" in names:
         monkeypatch.setattr(arrange_up.evaluation.evaluate, "evaluate_plan", refuse)
 
@@ -73,7 +73,7 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
     # A new particle count adds exactly its row, without redoing the nominal evaluation.
     calls = []
     repair_plan, evaluate_plan = (
-        arrange_up.repair.fixture_repair.repair_plan,
+        arrange_up.repair.repair_plan,
         arrange_up.evaluation.evaluate.evaluate_plan,
     )
 
@@ -85,7 +85,7 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
         calls.append(("evaluate", len(actions)))
         return evaluate_plan(problem, actions, **kwargs)
 
-    monkeypatch.setattr(arrange_up.repair.fixture_repair, "repair_plan", counting_repair)
+    monkeypatch.setattr(arrange_up.repair, "repair_plan", counting_repair)
     monkeypatch.setattr(arrange_up.evaluation.evaluate, "evaluate_plan", counting_evaluate)
     fixture_experiment(tmp_path, problems=("down-push",), **{**TINY, "particles": (3, 4)})
     assert [what for what, _ in calls] == ["repair", "evaluate"] and calls[0][1] == 4
@@ -94,9 +94,7 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
 
 def test_a_problem_without_nominal_plan_is_recorded_not_skipped(tmp_path, monkeypatch):
     # As if the deterministic planner found no plan for down-push.
-    monkeypatch.setattr(
-        "arrange_up.repair.fixture_repair.nominal_plans", lambda *_args, **_kwargs: []
-    )
+    monkeypatch.setattr("arrange_up.repair.nominal_plans", lambda *_args, **_kwargs: [])
     path = fixture_experiment(tmp_path, problems=("down-push",), **{**TINY, "plans": 2})
     table = rows(path)
     assert [(r["plan"], r["stage"], r["status"]) for r in table] == [
@@ -129,7 +127,7 @@ def test_failed_and_raising_repairs_are_recorded_with_their_reason(tmp_path, mon
             return FailedRepair()
         raise ValueError("not a nominal plan of this problem")
 
-    monkeypatch.setattr(arrange_up.repair.fixture_repair, "repair_plan", fake)
+    monkeypatch.setattr(arrange_up.repair, "repair_plan", fake)
     path = fixture_experiment(tmp_path, problems=("down-push",), **TINY)
     _, failed, error = rows(path)
     assert (failed["status"], failed["reason"]) == ("failed", FailedRepair.reason)

@@ -13,13 +13,15 @@ import math
 import pytest
 from click.testing import CliRunner
 
+import arrange_up.repair as rp
 from arrange_up.cli import main
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.model.world import Pick, Place, Push
 from arrange_up.planning.planner import plan
-from arrange_up.repair import fixture_repair as rp
+from arrange_up.repair import candidates
+from arrange_up.repair.repairer import Repairer
 from arrange_up.transitions.particles import DeterministicSemantics
 
 
@@ -251,13 +253,14 @@ def test_choice_needs_a_real_gain_for_a_fixture():
         pose = None if fixture is None else (1.0, 1.0, 0.0)
         return rp.Candidate(fixture, pose, multiplier, "ok", distance, push=push)
 
-    assert rp._choose([]) is None
+    assert candidates.choose([]) is None
     bare = cand(None, 1.0)
-    assert rp._choose([bare, cand("bar", 0.995)]) is bare  # 0.5% better: not worth two actions
+    # 0.5% better: not worth two actions
+    assert candidates.choose([bare, cand("bar", 0.995)]) is bare
     better = cand("bar", 0.9)
-    assert rp._choose([bare, better]) is better
-    assert rp._choose([cand(None, 1.0, 1.5), cand(None, 1.0, 1.25)]).multiplier == 1.25
-    scored = rp._normalise(
+    assert candidates.choose([bare, better]) is better
+    assert candidates.choose([cand(None, 1.0, 1.5), cand(None, 1.0, 1.25)]).multiplier == 1.25
+    scored = candidates.normalise(
         [
             cand(None, 2.0),
             cand("bar", 1.0),
@@ -270,7 +273,7 @@ def test_choice_needs_a_real_gain_for_a_fixture():
 def test_belief_intervals_span_angles_the_short_way(tz):
     # Z (symmetry period 180 deg) starts at 90 deg +- 1 deg: its canonical angle period is
     # centred on that start, so its interval is +-1 deg, not the whole period
-    repairer = rp._Repairer(tz, 30, 0, "enhanced", 1, None)
+    repairer = Repairer(tz, 30, 0, "enhanced", 1, None)
     belief = repairer.initial_belief()
     assert belief.intervals.get("Z").half[2] <= math.radians(1.0) + 1e-9
     assert repairer.intervals(belief).get("Z").half[2] <= math.radians(1.0) + 1e-9
@@ -366,3 +369,36 @@ def test_up_plan_repairer(down_push):
             assert got.distance == pytest.approx(want.distance, abs=1e-6)
     with pytest.raises(ValueError, match="method"):
         PlanRepairer(name="arrange-up-fixtures", params={"method": "clever"})
+
+
+# -- typed results --------------------------------------------------------------------------------
+def test_statuses_are_string_enums_and_statistics_a_dataclass(down_push, down_repair):
+    assert isinstance(down_repair.status, rp.RepairStatus)
+    assert down_repair.status == "solved" and json.dumps(down_repair.status) == '"solved"'
+    assert down_repair.steps[0].status == rp.StepStatus.OK == "ok"
+    assert all(isinstance(c.status, rp.CandidateStatus) for c in down_repair_scores(down_push))
+    stats = down_repair.statistics
+    assert isinstance(stats, rp.RepairStats)
+    assert list(down_repair.stats()) == [
+        "elapsed",
+        "simulations",
+        "steps",
+        "pushes",
+        "fixtures_placed",
+        "nominal_length",
+        "plan_length",
+    ]
+    assert down_repair.document(down_push)["search"] == stats.to_json()
+    assert stats.plan_length == len(down_repair.actions)
+
+
+def down_repair_scores(problem):
+    nominal = rp.nominal_plans(problem, 1, seed=0)[0]
+    return rp.step_scores(problem, nominal, 1, particles=4, seed=3).placements
+
+
+def test_the_former_module_path_still_works():
+    from arrange_up.repair import fixture_repair
+
+    for name in rp.__all__:
+        assert getattr(fixture_repair, name) is getattr(rp, name)
