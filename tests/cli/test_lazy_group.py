@@ -92,4 +92,3 @@ def test_unknown_command_exits_2():
 def test_version():
     result = CliRunner().invoke(main, ["--version"])
     assert result.exit_code == 0 and result.output.startswith("arrange-up, version ")
-
