@@ -29,6 +29,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from arrange_up.io.resources import shipped_dir
 from arrange_up.model.problem import ConvexPolygon, ObjectKind, Shape
 
 __all__ = [
@@ -46,10 +47,6 @@ CATALOGUE_FORMAT = "arrange-up-shapes/1"
 PDDL_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 #: Two shapes are the same when their outlines differ by less than this area (square inches).
 SAME_SHAPE_AREA = 1e-9
-
-_PACKAGE_DIR = Path(__file__).resolve().parent.parent
-_WHEEL_SEMANTICS = _PACKAGE_DIR / "_shipped" / "semantics"
-_CHECKOUT_SEMANTICS = _PACKAGE_DIR.parent / "semantics"
 
 
 class CatalogueError(ValueError):
@@ -103,13 +100,7 @@ class Catalogue:
 def semantics_dir() -> Path:
     """The folder of the shipped semantics: an installed wheel's
     ``arrange_up/_shipped/semantics`` or the checkout's ``semantics/``."""
-    for candidate in (_WHEEL_SEMANTICS, _CHECKOUT_SEMANTICS):
-        if candidate.is_dir():
-            return candidate
-    raise FileNotFoundError(
-        "arrange-up's shipped semantics are missing: looked in "
-        f"{_WHEEL_SEMANTICS} (installed wheel) and {_CHECKOUT_SEMANTICS} (checkout)"
-    )
+    return shipped_dir("semantics", "semantics")
 
 
 def catalogue_path() -> Path:
