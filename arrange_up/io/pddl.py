@@ -55,6 +55,7 @@ semantics (:mod:`arrange_up.up.compile`).
 from __future__ import annotations
 
 import re
+import textwrap
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from decimal import Decimal
@@ -62,7 +63,9 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
+from arrange_up.io import validation
 from arrange_up.io.shape_catalogue import PDDL_NAME, Catalogue, load_catalogue, semantics_dir
+from arrange_up.io.validation import Placed
 from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
 from arrange_up.model.problem import (
     WALL_EDGES,
@@ -405,8 +408,6 @@ def _decimal(value: Decimal) -> str:
 
 
 def _comment_block(text: str, width: int = 96) -> list[str]:
-    import textwrap
-
     wrapped = textwrap.wrap(text, width=width - 4) or [""]
     return ["; " + wrapped[0]] + [";   " + line for line in wrapped[1:]]
 
@@ -968,21 +969,18 @@ class _Builder:
         )
         return None
 
-    # -- checks shared with the YAML loader ------------------------------------------------
+    # -- placement (the semantic checks of io.validation, shared with the YAML reader) --------
     def check_placement(self, problem: ArrangementProblem) -> None:
-        from arrange_up.geometry import shapes as geometry
-        from arrange_up.io.yaml_problem import AREA_TOLERANCE, BOUNDS_TOLERANCE
-
-        placed = [(spec.name, spec.shape, spec.pose) for spec in problem.obstacles]
-        placed += [(e.name, problem.object(e.name).shape, e.pose) for e in problem.initial]
+        placed = []
+        for spec in problem.obstacles:
+            assert spec.pose is not None  # an obstacle always has its fixed pose
+            placed.append(Placed(spec.name, spec.shape, spec.pose))
+        placed += [Placed(e.name, problem.object(e.name).shape, e.pose) for e in problem.initial]
         width, depth = problem.table.size
-        footprints = []
-        for name, shape, pose in placed:
-            assert pose is not None
-            footprint = geometry.footprint(shape.parts, pose)
-            xmin, ymin, xmax, ymax = footprint.bounds
-            tol = BOUNDS_TOLERANCE
-            if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
+        for check in validation.check_placement(placed, problem.table.size):
+            name = check.name
+            if check.outside is not None:
+                xmin, ymin, xmax, ymax = check.outside
                 self.error(
                     f"init.x({name})",
                     rf"\(\s*x\s+{re.escape(name)}\s*\)",
@@ -990,16 +988,13 @@ class _Builder:
                     f"{_num(xmin)}..{_num(xmax)}, y {_num(ymin)}..{_num(ymax)}; expected it "
                     f"within [0, {_num(width)}] x [0, {_num(depth)}] in",
                 )
-            for other, other_footprint in footprints:
-                overlap = footprint.intersection(other_footprint).area
-                if overlap > AREA_TOLERANCE:
-                    self.error(
-                        f"init.x({name})",
-                        rf"\(\s*x\s+{re.escape(name)}\s*\)",
-                        f"{name} overlaps {other} at their nominal poses (overlap area "
-                        f"{_num(overlap)} in²); expected shapes that touch at most",
-                    )
-            footprints.append((name, footprint))
+            for index, overlap in check.overlaps:
+                self.error(
+                    f"init.x({name})",
+                    rf"\(\s*x\s+{re.escape(name)}\s*\)",
+                    f"{name} overlaps {placed[index].name} at their nominal poses (overlap area "
+                    f"{_num(overlap)} in²); expected shapes that touch at most",
+                )
 
 
 def _conjuncts(goals: Iterable[Any]) -> list[Any]:

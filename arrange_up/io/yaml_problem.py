@@ -62,11 +62,13 @@ import difflib
 import math
 import re
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from arrange_up.geometry import shapes as geometry
+from arrange_up.io import validation
+from arrange_up.io.validation import AREA_TOLERANCE, BOUNDS_TOLERANCE, Placed
 from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
 from arrange_up.model.problem import (
     WALL_EDGES,
@@ -103,10 +105,6 @@ SUPPORTED_FORMATS: tuple[str, ...] = (FORMAT_VERSION,)
 #: Goal tolerance in x and y (inches, whatever the file's units) when ``goal.tolerance`` is
 #: omitted; the angle is then unconstrained.
 DEFAULT_GOAL_TOLERANCE_IN = 0.2
-#: Overlap area (square inches) above which two shapes count as overlapping; touching is fine.
-AREA_TOLERANCE = 1e-9
-#: How far (inches) a footprint may stick out of the table and still count as inside.
-BOUNDS_TOLERANCE = 1e-9
 
 NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 TOP_LEVEL_KEYS = (
@@ -486,17 +484,6 @@ class _Object:
     pose: Pose | None = None
     pose_node: _Node | None = None
     ok: bool = True
-
-
-@dataclass
-class _Placed:
-    """A shape at a nominal pose, for the overlap and table checks."""
-
-    name: str
-    shape: Shape
-    pose: Pose
-    node: _Node
-    footprint: Any = field(default=None)
 
 
 class _Builder:
@@ -1078,49 +1065,47 @@ class _Builder:
 
         Objects whose shape, kind or pose is invalid are skipped (already reported).
         """
-        placed: list[_Placed] = []
+        placed: list[tuple[Placed, _Node]] = []
         for obj in objects.values():
             if obj.ok and obj.kind is ObjectKind.OBSTACLE:
                 assert obj.shape is not None and obj.pose is not None and obj.pose_node
-                placed.append(_Placed(obj.name, obj.shape, obj.pose, obj.pose_node))
+                placed.append((Placed(obj.name, obj.shape, obj.pose), obj.pose_node))
         for entry, node in initial:
             obj = objects[entry.name]
             if obj.ok and obj.shape is not None:
-                placed.append(_Placed(entry.name, obj.shape, entry.pose, node.child("pose")))
-        placed.sort(key=lambda p: (p.node.line or 0, p.node.column or 0))
-        for item in placed:
-            item.footprint = geometry.footprint(item.shape.parts, item.pose)
+                placed.append((Placed(entry.name, obj.shape, entry.pose), node.child("pose")))
+        placed.sort(key=lambda p: (p[1].line or 0, p[1].column or 0))
+        table_size = None if table is None else table.size
+        checks = validation.check_placement([item for item, _ in placed], table_size)
 
         units = self.units
         if table is not None:
             width, depth = table.size
-            for item in placed:
-                xmin, ymin, xmax, ymax = item.footprint.bounds
-                tol = BOUNDS_TOLERANCE
-                if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
+            for (item, node), check in zip(placed, checks, strict=True):
+                if check.outside is not None:
+                    xmin, ymin, xmax, ymax = check.outside
                     spans = ", ".join(
                         f"{axis} {_fmt(units.length_out(lo))}..{_fmt(units.length_out(hi))}"
                         for axis, lo, hi in (("x", xmin, xmax), ("y", ymin, ymax))
                     )
                     self.error(
-                        item.node,
+                        node,
                         f"{item.name} lies outside the table: at this nominal pose its shape "
                         f"spans {spans}; expected it within the table [0, "
                         f"{_fmt(units.length_out(width))}] x [0, "
                         f"{_fmt(units.length_out(depth))}] {units.length}",
                     )
         area_unit = units.length_factor**2
-        for j, later in enumerate(placed):
-            for earlier in placed[:j]:
-                overlap = later.footprint.intersection(earlier.footprint).area
-                if overlap > AREA_TOLERANCE:
-                    self.error(
-                        later.node,
-                        f"{later.name} overlaps {earlier.name} ({earlier.node.path}, line "
-                        f"{earlier.node.line}) at their nominal poses (overlap area "
-                        f"{_fmt(overlap / area_unit)} {units.length}²); expected shapes that "
-                        "touch at most",
-                    )
+        for (later, node), check in zip(placed, checks, strict=True):
+            for index, overlap in check.overlaps:
+                earlier, earlier_node = placed[index]
+                self.error(
+                    node,
+                    f"{later.name} overlaps {earlier.name} ({earlier_node.path}, line "
+                    f"{earlier_node.line}) at their nominal poses (overlap area "
+                    f"{_fmt(overlap / area_unit)} {units.length}²); expected shapes that "
+                    "touch at most",
+                )
 
     # -- goal -----------------------------------------------------------------------------------
     def goal(self, root: _Node, objects: dict[str, _Object]) -> Goal | None:
