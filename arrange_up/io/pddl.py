@@ -448,6 +448,8 @@ def load_pddl_problem_text(
     text: str, source: str = "<text>", domain: str | Path | None = None
 ) -> ArrangementProblem:
     """Like :func:`load_pddl_problem`, for PDDL ``text`` named ``source`` in messages."""
+    # Lazy: unified-planning is slow to import (docs/design/io.md) and io.domains imports this
+    # module, so loading a YAML problem by name would pay for it otherwise.
     from unified_planning.io import PDDLReader
 
     domain_file = Path(domain) if domain is not None else domain_path()

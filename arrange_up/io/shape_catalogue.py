@@ -6,14 +6,12 @@ type is: a kind (part, manipulator, fixture, obstacle) and a shape in one of the
 format's forms (``box``, ``polygon``, ``convex_parts``; inches). See that file's header.
 
 Shapes are built exactly as :mod:`arrange_up.io.yaml_problem` builds them from a ``.yaml`` file
-(same
-geometry functions, same order), so a problem whose objects use catalogue shapes is the same
-:class:`~arrange_up.model.problem.ArrangementProblem` whichever format it was read from. A box type
-gives an unnamed shape (like an inline ``{box: [w, h]}``); a polygon type gives a shape named
-after the type (like a shape declared under ``shapes:`` with that name).
+(same geometry functions, same order), so a problem whose objects use catalogue shapes is the
+same :class:`~arrange_up.model.problem.ArrangementProblem` whichever format it was read from. A
+box type gives an unnamed shape (like an inline ``{box: [w, h]}``); a polygon type gives a shape
+named after the type (like a shape declared under ``shapes:`` with that name).
 
-This module imports only the standard library, YAML and the geometry helpers; it never
-imports unified-planning.
+This module never imports unified-planning.
 
     >>> from arrange_up.io.shape_catalogue import load_catalogue
     >>> entry = load_catalogue().entry("block-1x1")
@@ -29,6 +27,12 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from ruamel.yaml import YAML
+from ruamel.yaml.error import YAMLError
+from shapely.geometry import Polygon
+from shapely.ops import unary_union
+
+from arrange_up.geometry import shapes as geometry
 from arrange_up.io.resources import shipped_dir
 from arrange_up.model.problem import ConvexPolygon, ObjectKind, Shape
 
@@ -120,9 +124,6 @@ def same_geometry(a: Shape, b: Shape) -> bool:
     """True if the two shapes cover the same region of their own frames."""
     if a.parts == b.parts:
         return True
-    from shapely.geometry import Polygon
-    from shapely.ops import unary_union
-
     outline_a = unary_union([Polygon(p) for p in a.parts])
     outline_b = unary_union([Polygon(p) for p in b.parts])
     return bool(outline_a.symmetric_difference(outline_b).area <= SAME_SHAPE_AREA)
@@ -133,9 +134,6 @@ def same_geometry(a: Shape, b: Shape) -> bool:
 # ---------------------------------------------------------------------------------------------
 @cache
 def _load(path: str) -> Catalogue:
-    from ruamel.yaml import YAML
-    from ruamel.yaml.error import YAMLError
-
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as error:
@@ -194,8 +192,6 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
     ``form`` is ``"box"`` (``value = [w, h]``; unnamed shape), ``"polygon"`` or
     ``"convex_parts"`` (shape named ``name``). Raises ``ValueError`` for invalid geometry.
     """
-    from arrange_up.geometry import shapes as geometry
-
     if form == "box":
         width, height = (float(v) for v in _numbers(value, 2))
         parts = (_as_polygon(geometry.ensure_ccw(geometry.box_polygon(width, height))),)
@@ -224,8 +220,6 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
 
 
 def _centred(parts: tuple[ConvexPolygon, ...], name: str) -> Shape:
-    from arrange_up.geometry import shapes as geometry
-
     cx, cy = geometry.parts_centroid(parts)
     shifted = tuple(_as_polygon(geometry.translate_polygon(p, -cx, -cy)) for p in parts)
     return Shape(shifted, name=name)
