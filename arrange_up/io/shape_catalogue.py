@@ -5,10 +5,10 @@ PDDL cannot describe geometry, so a ``.pddl`` problem types each object by a *sh
 type is: a kind (part, manipulator, fixture, obstacle) and a shape in one of the problem
 format's forms (``box``, ``polygon``, ``convex_parts``; inches). See that file's header.
 
-Shapes are built exactly as :mod:`arrange_up.io.yaml_problem` builds them from a ``.yaml`` file
-(same geometry functions, same order), so a problem whose objects use catalogue shapes is the
-same :class:`~arrange_up.model.problem.ArrangementProblem` whichever format it was read from. A
-box type gives an unnamed shape (like an inline ``{box: [w, h]}``); a polygon type gives a shape
+Shapes are built by :mod:`arrange_up.io.shape_forms`, as the YAML reader builds them from a
+``.yaml`` file, so a problem whose objects use catalogue shapes is the same
+:class:`~arrange_up.model.problem.ArrangementProblem` whichever format it was read from. A box
+type gives an unnamed shape (like an inline ``{box: [w, h]}``); a polygon type gives a shape
 named after the type (like a shape declared under ``shapes:`` with that name).
 
 This module never imports unified-planning.
@@ -34,7 +34,8 @@ from shapely.ops import unary_union
 
 from arrange_up.geometry import shapes as geometry
 from arrange_up.io.resources import shipped_dir
-from arrange_up.model.problem import ConvexPolygon, ObjectKind, Shape
+from arrange_up.io.shape_forms import box_shape, ccw_polygon, centred_shape, convex_decomposition
+from arrange_up.model.problem import ObjectKind, Shape
 
 __all__ = [
     "CATALOGUE_FORMAT",
@@ -194,18 +195,13 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
     """
     if form == "box":
         width, height = (float(v) for v in _numbers(value, 2))
-        parts = (_as_polygon(geometry.ensure_ccw(geometry.box_polygon(width, height))),)
-        return Shape(parts, box=(width, height), name=None)
+        return box_shape(width, height)
     if form == "polygon":
         points = _points(value)
         reason = geometry.polygon_problem(points)
         if reason:
             raise ValueError(f"the polygon {reason}")
-        pieces = tuple(
-            _as_polygon(geometry.ensure_ccw(p))
-            for p in geometry.decompose_convex(geometry.ensure_ccw(points))
-        )
-        return _centred(pieces, name)
+        return centred_shape(convex_decomposition(points), name)
     if form == "convex_parts":
         if not isinstance(value, list) or not value:
             raise ValueError("expected a non-empty list of convex polygons")
@@ -214,19 +210,9 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
             points = _points(item)
             if geometry.polygon_problem(points) or not geometry.is_convex(points):
                 raise ValueError(f"part [{index}] is not a valid convex polygon")
-            pieces.append(_as_polygon(geometry.ensure_ccw(points)))
-        return _centred(tuple(pieces), name)
+            pieces.append(ccw_polygon(points))
+        return centred_shape(tuple(pieces), name)
     raise ValueError(f"unknown shape form {form!r}")
-
-
-def _centred(parts: tuple[ConvexPolygon, ...], name: str) -> Shape:
-    cx, cy = geometry.parts_centroid(parts)
-    shifted = tuple(_as_polygon(geometry.translate_polygon(p, -cx, -cy)) for p in parts)
-    return Shape(shifted, name=name)
-
-
-def _as_polygon(poly: Any) -> ConvexPolygon:
-    return tuple((float(x), float(y)) for x, y in poly)
 
 
 def _numbers(value: Any, n: int) -> list[float]:

@@ -7,7 +7,8 @@ units and points at the YAML node; the PDDL reader speaks inches and points at t
 ``(x ...)`` fact).
 
 :func:`check_placement` says, for each object placed at its nominal pose, whether its footprint
-lies outside the table and which objects placed before it it overlaps, and by how much.
+lies outside the table and which objects placed before it it overlaps, and by how much;
+:func:`part_overlaps` which convex parts of one shape overlap (they may only touch).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from arrange_up.geometry import shapes as geometry
-from arrange_up.model.problem import Pose, Shape
+from arrange_up.model.problem import ConvexPolygon, Pose, Shape
 
 __all__ = [
     "AREA_TOLERANCE",
@@ -24,6 +25,7 @@ __all__ = [
     "Placed",
     "PlacementCheck",
     "check_placement",
+    "part_overlaps",
 ]
 
 #: Overlap area (square inches) above which two shapes count as overlapping; touching is fine.
@@ -90,3 +92,19 @@ def check_placement(
                 overlaps.append((i, area))
         checks.append(PlacementCheck(item.name, outside, tuple(overlaps)))
     return checks
+
+
+def part_overlaps(parts: Sequence[ConvexPolygon]) -> list[tuple[int, int, float]]:
+    """``(i, j, area)`` for every pair of convex parts ``i < j`` (indices into ``parts``, in the
+    shape's frame) that overlap by more than :data:`AREA_TOLERANCE` square inches, ordered by
+    ``j`` then ``i``."""
+    origin = (0.0, 0.0, 0.0)
+    found = []
+    for j in range(len(parts)):
+        for i in range(j):
+            a = geometry.footprint((parts[i],), origin)
+            b = geometry.footprint((parts[j],), origin)
+            area = float(a.intersection(b).area)
+            if area > AREA_TOLERANCE:
+                found.append((i, j, area))
+    return found

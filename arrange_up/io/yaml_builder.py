@@ -14,7 +14,8 @@ from typing import Any
 
 from arrange_up.geometry import shapes as geometry
 from arrange_up.io import validation
-from arrange_up.io.validation import AREA_TOLERANCE, Placed
+from arrange_up.io.shape_forms import box_shape, ccw_polygon, centred_shape, convex_decomposition
+from arrange_up.io.validation import Placed
 from arrange_up.io.yaml_source import Node, NodeReader, at, describe, fmt, is_number, suggest
 from arrange_up.model.problem import (
     WALL_EDGES,
@@ -277,8 +278,7 @@ class ProblemBuilder(NodeReader):
         if size is None:
             return None
         width, height = (self.units.length_in(v) for v in size)
-        parts = (_as_polygon(geometry.ensure_ccw(geometry.box_polygon(width, height))),)
-        return Shape(parts, box=(width, height), name=name)
+        return box_shape(width, height, name)
 
     def points(self, node: Node) -> list[Point] | None:
         """A polygon's vertices ``[[x, y], ...]`` (at least three), converted to inches."""
@@ -317,14 +317,11 @@ class ProblemBuilder(NodeReader):
         if points is None or not self.valid_polygon(node, points, "the polygon"):
             return None
         try:
-            parts = tuple(
-                _as_polygon(geometry.ensure_ccw(p))
-                for p in geometry.decompose_convex(geometry.ensure_ccw(tuple(points)))
-            )
+            parts = convex_decomposition(points)
         except Exception as error:
             self.error(node, f"the polygon could not be decomposed into convex parts ({error})")
             return None
-        return self.centred(parts, name)
+        return centred_shape(parts, name)
 
     def convex_parts(self, node: Node, name: str | None) -> Shape | None:
         items = self.list_of(node, "a non-empty list of convex polygons [[[x, y], ...], ...]")
@@ -345,29 +342,20 @@ class ProblemBuilder(NodeReader):
                 )
                 ok = False
                 continue
-            parts.append((index, item, _as_polygon(geometry.ensure_ccw(tuple(points)))))
+            parts.append((index, item, ccw_polygon(points)))
         area_unit = self.units.length_factor**2
-        for j in range(len(parts)):
-            for i in range(j):
-                (index_i, _, part_i), (index_j, node_j, part_j) = parts[i], parts[j]
-                overlap = _overlap_area((part_i,), (0.0, 0.0, 0.0), (part_j,), (0.0, 0.0, 0.0))
-                if overlap > AREA_TOLERANCE:
-                    self.error(
-                        node_j,
-                        f"parts [{index_i}] and [{index_j}] overlap (area "
-                        f"{fmt(overlap / area_unit)} {self.units.length}²); the convex parts of "
-                        "a shape may touch but not overlap",
-                    )
-                    ok = False
+        for i, j, overlap in validation.part_overlaps([p for _, _, p in parts]):
+            (index_i, _, _), (index_j, node_j, _) = parts[i], parts[j]
+            self.error(
+                node_j,
+                f"parts [{index_i}] and [{index_j}] overlap (area "
+                f"{fmt(overlap / area_unit)} {self.units.length}²); the convex parts of "
+                "a shape may touch but not overlap",
+            )
+            ok = False
         if not ok:
             return None
-        return self.centred(tuple(p for _, _, p in parts), name)
-
-    @staticmethod
-    def centred(parts: tuple[ConvexPolygon, ...], name: str | None) -> Shape:
-        cx, cy = geometry.parts_centroid(parts)
-        shifted = tuple(_as_polygon(geometry.translate_polygon(p, -cx, -cy)) for p in parts)
-        return Shape(shifted, name=name)
+        return centred_shape(tuple(p for _, _, p in parts), name)
 
     # -- objects --------------------------------------------------------------------------------
     def objects(self, root: Node, shapes: dict[str, Shape | None]) -> dict[str, _Object]:
@@ -826,22 +814,3 @@ class ProblemBuilder(NodeReader):
             else:
                 chosen.append(str(item.value))
         return tuple(chosen) if ok else None
-
-
-# ---------------------------------------------------------------------------------------------
-# geometry glue
-# ---------------------------------------------------------------------------------------------
-def _as_polygon(poly: Any) -> ConvexPolygon:
-    """A polygon as a tuple of ``(x, y)`` float tuples (what :class:`Shape` stores)."""
-    return tuple((float(x), float(y)) for x, y in poly)
-
-
-def _overlap_area(
-    parts_a: tuple[ConvexPolygon, ...],
-    pose_a: Pose,
-    parts_b: tuple[ConvexPolygon, ...],
-    pose_b: Pose,
-) -> float:
-    a = geometry.footprint(parts_a, pose_a)
-    b = geometry.footprint(parts_b, pose_b)
-    return float(a.intersection(b).area)

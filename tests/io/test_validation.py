@@ -6,7 +6,7 @@ import pytest
 
 from arrange_up.geometry import shapes as geometry
 from arrange_up.io.pddl import load_pddl_problem_text, write_pddl_problem
-from arrange_up.io.validation import AREA_TOLERANCE, Placed, check_placement
+from arrange_up.io.validation import AREA_TOLERANCE, Placed, check_placement, part_overlaps
 from arrange_up.io.yaml_problem import check_problem_text, load_problem_text
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import Shape
@@ -82,3 +82,13 @@ def test_both_readers_report_the_same_placement_problems() -> None:
         assert outside.message.startswith("C lies outside the table")
         assert "x 9.3..10.3, y 0.5..1.5" in outside.message
         assert overlap.line is not None and outside.line is not None
+
+
+def test_part_overlaps_reports_each_overlapping_pair_once() -> None:
+    left = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
+    touching = ((1.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0))
+    across = ((0.5, 0.0), (1.5, 0.0), (1.5, 0.5), (0.5, 0.5))
+    ((i, j, area), (i2, j2, area2)) = part_overlaps([left, touching, across])
+    assert (i, j, i2, j2) == (0, 2, 1, 2)
+    assert area == pytest.approx(0.25) and area2 == pytest.approx(0.25)
+    assert part_overlaps([left, touching]) == []
