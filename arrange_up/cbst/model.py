@@ -43,6 +43,7 @@ from arrange_up.cbst.features import (
     THESIS_TEST_RMSE,
     Domain,
 )
+from arrange_up.io.resources import shipped_dir
 
 __all__ = [
     "CARD_FORMAT",
@@ -70,12 +71,6 @@ DEFAULT_GRID: dict[str, list[Any]] = {
     "min_samples_leaf": [12, 24, 48],
     "residual": [None, DY_RESIDUAL],
 }
-
-_PACKAGE_DIR = Path(__file__).resolve().parent.parent
-#: Where an installed wheel keeps shipped models (``force-include`` in pyproject.toml).
-_WHEEL_MODELS = _PACKAGE_DIR / "_shipped" / "semantics" / "cbst"
-#: Where a checkout (or an editable install) keeps them.
-_CHECKOUT_MODELS = _PACKAGE_DIR.parent / "semantics" / "cbst"
 
 ProgressCallback = Callable[[str, int, int], None]
 
@@ -291,13 +286,7 @@ def _jsonable(value: Any) -> Any:
 def model_dir() -> Path:
     """The folder of shipped models: the wheel's ``_shipped/semantics/cbst`` if present, else
     the checkout's ``semantics/cbst``."""
-    for candidate in (_WHEEL_MODELS, _CHECKOUT_MODELS):
-        if candidate.is_dir():
-            return candidate
-    raise FileNotFoundError(
-        "arrange-up's shipped CBST models are missing: looked in "
-        f"{_WHEEL_MODELS} (installed wheel) and {_CHECKOUT_MODELS} (checkout)"
-    )
+    return shipped_dir("semantics/cbst", "CBST models")
 
 
 def save_model(

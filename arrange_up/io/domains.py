@@ -11,12 +11,8 @@ for, a user may give either a path to a problem file or the name of a shipped pr
     False
 
 The shipped files live in the repository's ``domains/`` folder; an installed wheel carries the
-same folder as ``arrange_up/_shipped/domains`` (see ``[tool.hatch.build.targets.wheel]`` in
-``pyproject.toml``), so names work without a checkout. :func:`domains_dir` finds whichever is
-present.
-
-This module imports only the standard library at import time; YAML and the loader are imported
-when a function needs them.
+same folder as ``arrange_up/_shipped/domains`` (see :mod:`arrange_up.io.resources`), so names
+work without a checkout. :func:`domains_dir` finds whichever is present.
 """
 
 from __future__ import annotations
@@ -26,10 +22,14 @@ import difflib
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-if TYPE_CHECKING:
-    from arrange_up.model.problem import ArrangementProblem
+from ruamel.yaml import YAML
+
+from arrange_up.io.pddl import load_pddl_problem
+from arrange_up.io.resources import shipped_dir
+from arrange_up.io.yaml_problem import load_problem
+from arrange_up.model.problem import ArrangementProblem
 
 __all__ = [
     "PROBLEM_SUFFIXES",
@@ -45,12 +45,6 @@ __all__ = [
 
 #: File suffixes of problem files, in order of preference when a name matches several files.
 PROBLEM_SUFFIXES: tuple[str, ...] = (".yaml", ".yml", ".pddl")
-
-_PACKAGE_DIR = Path(__file__).resolve().parent.parent
-#: Where an installed wheel keeps the shipped problems (``force-include`` in pyproject.toml).
-_WHEEL_DOMAINS = _PACKAGE_DIR / "_shipped" / "domains"
-#: Where a checkout (or an editable install) keeps them.
-_CHECKOUT_DOMAINS = _PACKAGE_DIR.parent / "domains"
 
 _SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=[A-Z])")
 
@@ -119,13 +113,7 @@ def domains_dir() -> Path:
     Raises:
         FileNotFoundError: neither folder exists (a broken installation).
     """
-    for candidate in (_WHEEL_DOMAINS, _CHECKOUT_DOMAINS):
-        if candidate.is_dir():
-            return candidate
-    raise FileNotFoundError(
-        "arrange-up's shipped domains are missing: looked in "
-        f"{_WHEEL_DOMAINS} (installed wheel) and {_CHECKOUT_DOMAINS} (checkout)"
-    )
+    return shipped_dir("domains", "domains")
 
 
 def _shipped_files() -> dict[str, Path]:
@@ -154,8 +142,6 @@ def first_sentence(text: str) -> str:
 
 def _scan_yaml(path: Path) -> tuple[str, int, str]:
     """``(description, parts, goal kind)`` read from a YAML problem without validating it."""
-    from ruamel.yaml import YAML
-
     data: Any = YAML(typ="safe", pure=True).load(path.read_text(encoding="utf-8"))
     if not isinstance(data, dict):
         return "", 0, "?"
@@ -275,11 +261,7 @@ def load_problem_file(path: str | Path) -> ArrangementProblem:
     """Load a problem file by its suffix: ``.pddl`` through the PDDL front end, anything else
     as YAML. Raises :class:`arrange_up.model.errors.ProblemFormatError`."""
     if Path(path).suffix.lower() == ".pddl":
-        from arrange_up.io.pddl import load_pddl_problem
-
         return load_pddl_problem(path)
-    from arrange_up.io.yaml_problem import load_problem
-
     return load_problem(path)
 
 

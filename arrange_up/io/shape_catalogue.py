@@ -5,15 +5,13 @@ PDDL cannot describe geometry, so a ``.pddl`` problem types each object by a *sh
 type is: a kind (part, manipulator, fixture, obstacle) and a shape in one of the problem
 format's forms (``box``, ``polygon``, ``convex_parts``; inches). See that file's header.
 
-Shapes are built exactly as :mod:`arrange_up.io.yaml_problem` builds them from a ``.yaml`` file
-(same
-geometry functions, same order), so a problem whose objects use catalogue shapes is the same
-:class:`~arrange_up.model.problem.ArrangementProblem` whichever format it was read from. A box type
-gives an unnamed shape (like an inline ``{box: [w, h]}``); a polygon type gives a shape named
-after the type (like a shape declared under ``shapes:`` with that name).
+Shapes are built by :mod:`arrange_up.io.shape_forms`, as the YAML reader builds them from a
+``.yaml`` file, so a problem whose objects use catalogue shapes is the same
+:class:`~arrange_up.model.problem.ArrangementProblem` whichever format it was read from. A box
+type gives an unnamed shape (like an inline ``{box: [w, h]}``); a polygon type gives a shape
+named after the type (like a shape declared under ``shapes:`` with that name).
 
-This module imports only the standard library, YAML and the geometry helpers; it never
-imports unified-planning.
+This module never imports unified-planning.
 
     >>> from arrange_up.io.shape_catalogue import load_catalogue
     >>> entry = load_catalogue().entry("block-1x1")
@@ -29,7 +27,15 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from arrange_up.model.problem import ConvexPolygon, ObjectKind, Shape
+from ruamel.yaml import YAML
+from ruamel.yaml.error import YAMLError
+from shapely.geometry import Polygon
+from shapely.ops import unary_union
+
+from arrange_up.geometry import shapes as geometry
+from arrange_up.io.resources import shipped_dir
+from arrange_up.io.shape_forms import box_shape, ccw_polygon, centred_shape, convex_decomposition
+from arrange_up.model.problem import ObjectKind, Shape
 
 __all__ = [
     "CATALOGUE_FORMAT",
@@ -46,10 +52,6 @@ CATALOGUE_FORMAT = "arrange-up-shapes/1"
 PDDL_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 #: Two shapes are the same when their outlines differ by less than this area (square inches).
 SAME_SHAPE_AREA = 1e-9
-
-_PACKAGE_DIR = Path(__file__).resolve().parent.parent
-_WHEEL_SEMANTICS = _PACKAGE_DIR / "_shipped" / "semantics"
-_CHECKOUT_SEMANTICS = _PACKAGE_DIR.parent / "semantics"
 
 
 class CatalogueError(ValueError):
@@ -103,13 +105,7 @@ class Catalogue:
 def semantics_dir() -> Path:
     """The folder of the shipped semantics: an installed wheel's
     ``arrange_up/_shipped/semantics`` or the checkout's ``semantics/``."""
-    for candidate in (_WHEEL_SEMANTICS, _CHECKOUT_SEMANTICS):
-        if candidate.is_dir():
-            return candidate
-    raise FileNotFoundError(
-        "arrange-up's shipped semantics are missing: looked in "
-        f"{_WHEEL_SEMANTICS} (installed wheel) and {_CHECKOUT_SEMANTICS} (checkout)"
-    )
+    return shipped_dir("semantics", "semantics")
 
 
 def catalogue_path() -> Path:
@@ -129,9 +125,6 @@ def same_geometry(a: Shape, b: Shape) -> bool:
     """True if the two shapes cover the same region of their own frames."""
     if a.parts == b.parts:
         return True
-    from shapely.geometry import Polygon
-    from shapely.ops import unary_union
-
     outline_a = unary_union([Polygon(p) for p in a.parts])
     outline_b = unary_union([Polygon(p) for p in b.parts])
     return bool(outline_a.symmetric_difference(outline_b).area <= SAME_SHAPE_AREA)
@@ -142,9 +135,6 @@ def same_geometry(a: Shape, b: Shape) -> bool:
 # ---------------------------------------------------------------------------------------------
 @cache
 def _load(path: str) -> Catalogue:
-    from ruamel.yaml import YAML
-    from ruamel.yaml.error import YAMLError
-
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as error:
@@ -203,22 +193,15 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
     ``form`` is ``"box"`` (``value = [w, h]``; unnamed shape), ``"polygon"`` or
     ``"convex_parts"`` (shape named ``name``). Raises ``ValueError`` for invalid geometry.
     """
-    from arrange_up.geometry import shapes as geometry
-
     if form == "box":
         width, height = (float(v) for v in _numbers(value, 2))
-        parts = (_as_polygon(geometry.ensure_ccw(geometry.box_polygon(width, height))),)
-        return Shape(parts, box=(width, height), name=None)
+        return box_shape(width, height)
     if form == "polygon":
         points = _points(value)
         reason = geometry.polygon_problem(points)
         if reason:
             raise ValueError(f"the polygon {reason}")
-        pieces = tuple(
-            _as_polygon(geometry.ensure_ccw(p))
-            for p in geometry.decompose_convex(geometry.ensure_ccw(points))
-        )
-        return _centred(pieces, name)
+        return centred_shape(convex_decomposition(points), name)
     if form == "convex_parts":
         if not isinstance(value, list) or not value:
             raise ValueError("expected a non-empty list of convex polygons")
@@ -227,21 +210,9 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
             points = _points(item)
             if geometry.polygon_problem(points) or not geometry.is_convex(points):
                 raise ValueError(f"part [{index}] is not a valid convex polygon")
-            pieces.append(_as_polygon(geometry.ensure_ccw(points)))
-        return _centred(tuple(pieces), name)
+            pieces.append(ccw_polygon(points))
+        return centred_shape(tuple(pieces), name)
     raise ValueError(f"unknown shape form {form!r}")
-
-
-def _centred(parts: tuple[ConvexPolygon, ...], name: str) -> Shape:
-    from arrange_up.geometry import shapes as geometry
-
-    cx, cy = geometry.parts_centroid(parts)
-    shifted = tuple(_as_polygon(geometry.translate_polygon(p, -cx, -cy)) for p in parts)
-    return Shape(shifted, name=name)
-
-
-def _as_polygon(poly: Any) -> ConvexPolygon:
-    return tuple((float(x), float(y)) for x, y in poly)
 
 
 def _numbers(value: Any, n: int) -> list[float]:

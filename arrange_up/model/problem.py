@@ -19,7 +19,10 @@ Contracts that hold for every loaded problem:
 
 from __future__ import annotations
 
+import dataclasses
 import enum
+import hashlib
+import json
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -255,9 +258,6 @@ def problem_hash(problem: ArrangementProblem) -> str:
     other units or in another format (``.yaml`` or ``.pddl``) hashes the same. The description,
     the file's units and its location are not part of the content.
     """
-    import dataclasses
-    import hashlib
-    import json
 
     def canonical(value: object) -> object:
         if dataclasses.is_dataclass(value) and not isinstance(value, type):

@@ -162,6 +162,7 @@ def test_load_by_name_from_an_installed_wheel_layout(tmp_path, monkeypatch):
     import shutil
 
     from arrange_up.cbst import model as model_module
+    from arrange_up.io import resources
 
     shipped = tmp_path / "_shipped" / "semantics" / "cbst"
     shipped.mkdir(parents=True)
@@ -171,7 +172,7 @@ def test_load_by_name_from_an_installed_wheel_layout(tmp_path, monkeypatch):
     card = json.loads((shipped / "wheel-only.json").read_text())
     card["arrays"]["file"] = "wheel-only.npz"
     (shipped / "wheel-only.json").write_text(json.dumps(card))
-    monkeypatch.setattr(model_module, "_WHEEL_MODELS", shipped)
+    monkeypatch.setattr(resources, "WHEEL_DIR", tmp_path / "_shipped")
     assert model_module.model_dir() == shipped
     model = load_model("wheel-only")
     assert model.card_["arrays"]["file"] == "wheel-only.npz"

@@ -11,7 +11,7 @@ import pytest
 import shapely
 
 from arrange_up.geometry import shapes as geometry
-from arrange_up.io import domains
+from arrange_up.io import domains, resources
 from arrange_up.io.domains import (
     DomainInfo,
     UnknownDomainError,
@@ -345,11 +345,11 @@ def test_wheel_layout_is_preferred(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     shipped = tmp_path / "_shipped" / "domains"
     shipped.mkdir(parents=True)
     shutil.copy(domains_dir() / "blocks-1.yaml", shipped / "blocks-1.yaml")
-    monkeypatch.setattr(domains, "_WHEEL_DOMAINS", shipped)
+    monkeypatch.setattr(resources, "WHEEL_DIR", tmp_path / "_shipped")
     assert domains_dir() == shipped
     assert domain_names() == ["blocks-1"]
-    monkeypatch.setattr(domains, "_CHECKOUT_DOMAINS", tmp_path / "missing")
-    monkeypatch.setattr(domains, "_WHEEL_DOMAINS", tmp_path / "missing-too")
+    monkeypatch.setattr(resources, "CHECKOUT_DIR", tmp_path / "missing")
+    monkeypatch.setattr(resources, "WHEEL_DIR", tmp_path / "missing-too")
     with pytest.raises(FileNotFoundError):
         domains_dir()
 
@@ -360,7 +360,8 @@ def test_wheel_mapping_matches_pyproject() -> None:
     config = tomllib.loads(pyproject.read_text())
     force = config["tool"]["hatch"]["build"]["targets"]["wheel"]["force-include"]
     package = Path(domains.__file__).resolve().parents[1]
-    assert package.parent / force["domains"] == domains._WHEEL_DOMAINS
+    for name in ("domains", "semantics"):
+        assert package.parent / force[name] == resources.WHEEL_DIR / name
 
 
 def test_load_by_name_and_by_path() -> None:

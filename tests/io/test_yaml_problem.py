@@ -1,4 +1,5 @@
-"""Tests of the ``.yaml`` problem loader (``arrange_up.io.yaml_problem``) and its diagnostics."""
+"""Tests of the ``.yaml`` problem reader (``arrange_up.io.yaml_problem`` and the modules it
+uses: ``yaml_source``, ``yaml_builder``) and its diagnostics."""
 
 from __future__ import annotations
 

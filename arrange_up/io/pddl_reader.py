@@ -1,0 +1,634 @@
+"""Reading a PDDL problem of the arrange-up domain into an
+:class:`~arrange_up.model.problem.ArrangementProblem`, through unified-planning's ``PDDLReader``
+(see :mod:`arrange_up.io.pddl` for the vocabulary), with diagnostics located in the text."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from arrange_up.io import validation
+from arrange_up.io.pddl_domain import (
+    ANGLE_FUNCTIONS,
+    DOMAIN_FILE,
+    DOMAIN_NAME,
+    NOISE_FUNCTIONS,
+    PDDL_UNITS,
+    POSE_FUNCTIONS,
+    RELATIVE_FUNCTIONS,
+    SPREAD_FUNCTIONS,
+    TABLE_FUNCTIONS,
+    WALL_PREDICATES,
+    domain_path,
+    num,
+)
+from arrange_up.io.shape_catalogue import load_catalogue
+from arrange_up.io.validation import Placed
+from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
+from arrange_up.model.problem import (
+    ArrangementProblem,
+    Goal,
+    InitialObject,
+    ObjectKind,
+    ObjectSpec,
+    Table,
+    Uncertainty,
+)
+
+__all__ = ["load_pddl_problem", "load_pddl_problem_text", "problem_from_up"]
+
+
+def load_pddl_problem(path: str | Path, domain: str | Path | None = None) -> ArrangementProblem:
+    """Load a ``.pddl`` problem of the arrange-up domain (default: the shipped domain file).
+
+    Raises :class:`~arrange_up.model.errors.ProblemFormatError` whose diagnostics name the file,
+    the line and column where they can (UP's reader reports little; the offending object or
+    fluent is looked up in the text) and what was expected.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise ProblemFormatError(
+            [Diagnostic(source, None, None, "", "no such file; expected a .pddl problem file")]
+        ) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ProblemFormatError(
+            [Diagnostic(source, None, None, "", f"cannot read the file: {error}")]
+        ) from None
+    return load_pddl_problem_text(text, source, domain=domain)
+
+
+def load_pddl_problem_text(
+    text: str, source: str = "<text>", domain: str | Path | None = None
+) -> ArrangementProblem:
+    """Like :func:`load_pddl_problem`, for PDDL ``text`` named ``source`` in messages."""
+    # Lazy: unified-planning is slow to import (docs/design/io.md) and io.domains imports this
+    # module, so loading a YAML problem by name would pay for it otherwise.
+    from unified_planning.io import PDDLReader
+
+    domain_file = Path(domain) if domain is not None else domain_path()
+    domain_text = domain_file.read_text(encoding="utf-8")
+    located = _Text(text)
+    declared = located.domain_name()
+    if declared is not None and declared.lower() != DOMAIN_NAME:
+        line, column = located.find(r"\(\s*:domain\s+" + re.escape(declared))
+        raise ProblemFormatError(
+            [
+                Diagnostic(
+                    source,
+                    line,
+                    column,
+                    ":domain",
+                    f"the problem is for domain {declared!r}; expected {DOMAIN_NAME!r} "
+                    f"(arrange-up reads problems of its own domain, {DOMAIN_FILE})",
+                )
+            ]
+        )
+    try:
+        up_problem = PDDLReader().parse_problem_string(domain_text, text)
+    except Exception as error:  # UP raises many kinds; each becomes one diagnostic
+        raise ProblemFormatError([_reader_diagnostic(error, source, located)]) from None
+    return problem_from_up(up_problem, source=source, text=text)
+
+
+def problem_from_up(
+    up_problem: Any, *, source: str | None = None, text: str | None = None
+) -> ArrangementProblem:
+    """Rebuild an :class:`ArrangementProblem` from a UP problem in the PDDL vocabulary (as
+    ``PDDLReader`` makes it from a problem of the arrange-up domain).
+
+    ``text`` (the problem's PDDL source) restores the names' written case and locates
+    diagnostics; without it names stay as UP holds them (lowercase). Raises
+    :class:`~arrange_up.model.errors.ProblemFormatError` listing every problem found.
+    """
+    source = source or f"<unified-planning problem {up_problem.name}>"
+    builder = _Builder(up_problem, source, _Text(text) if text is not None else None)
+    problem = builder.build()
+    errors = [d for d in builder.diagnostics if d.is_error]
+    if errors or problem is None:
+        if not errors:  # pragma: no cover - every refusal records an error
+            builder.error("", "", "the problem could not be rebuilt")
+        raise ProblemFormatError(sort_diagnostics(builder.diagnostics))
+    return problem
+
+
+class _Text:
+    """The PDDL source of a problem: names as written, and positions of things in it."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        # comments blanked out (same length, so positions stay valid)
+        self.code = re.sub(r";[^\n]*", lambda m: " " * len(m.group(0)), text)
+
+    def position(self, index: int) -> tuple[int, int]:
+        before = self.text[:index]
+        return before.count("\n") + 1, index - (before.rfind("\n") + 1) + 1
+
+    def find(self, pattern: str) -> tuple[int | None, int | None]:
+        match = re.search(pattern, self.code, flags=re.IGNORECASE)
+        return self.position(match.start()) if match else (None, None)
+
+    def domain_name(self) -> str | None:
+        match = re.search(r"\(\s*:domain\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
+        return match.group(1) if match else None
+
+    def problem_name(self) -> str | None:
+        match = re.search(r"\(\s*problem\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
+        return match.group(1) if match else None
+
+    def object_names(self) -> list[str]:
+        """Object names in the ``:objects`` section, as written, in order."""
+        match = re.search(r"\(\s*:objects\b", self.code, flags=re.IGNORECASE)
+        if not match:
+            return []
+        depth, end = 1, match.end()
+        while end < len(self.code) and depth:
+            depth += {"(": 1, ")": -1}.get(self.code[end], 0)
+            end += 1
+        tokens = self.code[match.end() : end - 1].split()
+        names, skip = [], False
+        for token in tokens:
+            if skip:
+                skip = False
+            elif token == "-":
+                skip = True
+            else:
+                names.append(token)
+        return names
+
+    def description(self) -> str:
+        """The ``; description:`` comment block written by :func:`write_pddl_problem`."""
+        lines = self.text.splitlines()
+        for i, line in enumerate(lines):
+            if line.startswith("; description:"):
+                parts = [line[len("; description:") :].strip()]
+                for more in lines[i + 1 :]:
+                    if not more.startswith(";   "):
+                        break
+                    parts.append(more[4:].strip())
+                return " ".join(parts)
+        return ""
+
+
+def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnostic:
+    line = column = None
+    message = str(error).strip() or type(error).__name__
+    if hasattr(error, "lineno") and hasattr(error, "col"):  # pyparsing's ParseException
+        line, column = int(error.lineno), int(error.col)
+        message = f"not valid PDDL: {getattr(error, 'msg', message)}"
+    elif isinstance(error, KeyError):
+        name = str(error.args[0]) if error.args else "?"
+        line, column = located.find(rf"(?<![\w-]){re.escape(name)}(?![\w-])")
+        message = (
+            f"unknown name {name!r}: not a type, function or object of the {DOMAIN_NAME} "
+            f"domain ({DOMAIN_FILE}); object types must be shape types of "
+            f"{load_catalogue().path} ({', '.join(load_catalogue().type_names)})"
+        )
+    else:
+        found = re.search(r"line:?\s*(\d+),\s*col:?\s*(\d+)", message)
+        if found:
+            line, column = int(found.group(1)), int(found.group(2))
+        message = f"unified-planning's PDDL reader refused the problem: {message}"
+    return Diagnostic(source, line, column, "", message)
+
+
+@dataclass
+class _Builder:
+    """Rebuilds an :class:`ArrangementProblem` from a UP problem in the PDDL vocabulary."""
+
+    up: Any
+    source: str
+    located: _Text | None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.catalogue = load_catalogue()
+        written = self.located.object_names() if self.located is not None else []
+        self.case = {name.lower(): name for name in written}
+
+    # -- diagnostics ---------------------------------------------------------------------
+    def error(self, path: str, pattern: str, message: str, severity: str = "error") -> None:
+        line = column = None
+        if self.located is not None and pattern:
+            line, column = self.located.find(pattern)
+        self.diagnostics.append(
+            Diagnostic(self.source, line, column, path, message, severity)  # type: ignore[arg-type]
+        )
+
+    def name(self, up_name: str) -> str:
+        return self.case.get(up_name.lower(), up_name)
+
+    # -- the whole problem -----------------------------------------------------------------
+    def build(self) -> ArrangementProblem | None:
+        kinds, objects = self.objects()
+        values = self.initial_values(kinds)
+        table = self.table(values)
+        uncertainty = self.uncertainty(values)
+        initial, obstacles = self.poses(values, kinds)
+        goal = self.goal(kinds)
+        if any(d.is_error for d in self.diagnostics):
+            return None
+        assert table is not None and uncertainty is not None and goal is not None
+        specs = tuple(
+            ObjectSpec(spec.name, spec.kind, spec.shape, obstacles.get(spec.name))
+            for spec in objects
+        )
+        name = self.up.name
+        if self.located is not None:
+            name = self.located.problem_name() or name
+        problem = ArrangementProblem(
+            name=name,
+            table=table,
+            objects=specs,
+            initial=tuple(initial),
+            goal=goal,
+            uncertainty=uncertainty,
+            description=self.located.description() if self.located is not None else "",
+            units=PDDL_UNITS,
+            source=self.source,
+        )
+        self.check_placement(problem)
+        return None if any(d.is_error for d in self.diagnostics) else problem
+
+    # -- objects ---------------------------------------------------------------------------
+    def objects(self) -> tuple[dict[str, ObjectKind], list[ObjectSpec]]:
+        kinds: dict[str, ObjectKind] = {}
+        specs: list[ObjectSpec] = []
+        order = {name.lower(): i for i, name in enumerate(self.case.values())}
+        up_objects = sorted(self.up.all_objects, key=lambda o: order.get(o.name.lower(), 1 << 30))
+        for obj in up_objects:
+            name = self.name(obj.name)
+            type_name = obj.type.name
+            entry = self.catalogue.entry(type_name)
+            if entry is None:
+                self.error(
+                    f"objects.{name}",
+                    rf"(?<![\w-]){re.escape(obj.name)}\s+-",
+                    f"object {name} has type {type_name!r}; expected a shape type of the "
+                    f"catalogue {self.catalogue.path} ({', '.join(self.catalogue.type_names)})",
+                )
+                continue
+            kinds[name] = entry.kind
+            specs.append(ObjectSpec(name, entry.kind, entry.shape))
+        if not specs and not any(d.is_error for d in self.diagnostics):
+            self.error("objects", r"\(\s*:objects", "no objects; expected at least one part")
+        return kinds, specs
+
+    # -- :init -----------------------------------------------------------------------------
+    def initial_values(self, kinds: dict[str, ObjectKind]) -> dict[tuple[str, ...], Any]:
+        """``(function, arg, ...) -> value`` (Fraction or bool) of every explicit value."""
+        out: dict[tuple[str, ...], Any] = {}
+        for fluent_exp, value in self.up.explicit_initial_values.items():
+            key = (fluent_exp.fluent().name, *(self.name(a.object().name) for a in fluent_exp.args))
+            if value.is_bool_constant():
+                out[key] = value.bool_constant_value()
+            else:
+                out[key] = Fraction(value.constant_value())
+        return out
+
+    def number(self, values: dict, key: tuple[str, ...], default: Fraction | None) -> Any:
+        value = values.get(key, default)
+        if value is None:
+            return None
+        return Fraction(value)
+
+    def table(self, values: dict) -> Table | None:
+        size = []
+        for name in TABLE_FUNCTIONS:
+            value = values.get((name,))
+            if value is None:
+                self.error(
+                    "init",
+                    r"\(\s*:init",
+                    f"missing ({name}); expected the table's size in inches, e.g. (= ({name}) 10)",
+                )
+            elif value <= 0:
+                self.error(
+                    f"init.{name}",
+                    rf"\(\s*{name}\s*\)",
+                    f"({name}) is {num(float(value))}; expected a positive size in inches",
+                )
+            else:
+                size.append(float(value))
+        walls = tuple(edge for pred, edge in WALL_PREDICATES.items() if values.get((pred,)))
+        return Table((size[0], size[1]), walls) if len(size) == 2 else None
+
+    def uncertainty(self, values: dict) -> Uncertainty | None:
+        defaults = Uncertainty()
+        fields: dict[str, list[float]] = {
+            attr: list(getattr(defaults, attr)) for attr, _ in NOISE_FUNCTIONS.values()
+        }
+        given: dict[str, set[int]] = {attr: set() for attr in fields}
+        ok = True
+        for name, (attr, index) in NOISE_FUNCTIONS.items():
+            value = values.get((name,))
+            if value is None:
+                continue
+            if value < 0:
+                self.error(
+                    f"init.{name}",
+                    rf"\(\s*{name}\s*\)",
+                    f"({name}) is {num(float(value))}; expected a value >= 0",
+                )
+                ok = False
+                continue
+            fields[attr][index] = self.convert(name, value)
+            given[attr].add(index)
+        for attr in ("friction", "part_density", "manipulator_density"):
+            stem = attr.replace("_", "-")
+            if len(given[attr]) == 1:
+                self.error(
+                    "init",
+                    rf"\(\s*{stem}-(min|max)\s*\)",
+                    f"only one of ({stem}-min) and ({stem}-max) is given; expected both (a "
+                    "uniform range) or neither (the default)",
+                )
+                ok = False
+            elif fields[attr][0] > fields[attr][1]:
+                self.error(
+                    "init",
+                    rf"\(\s*{stem}-min\s*\)",
+                    f"({stem}-min) is above ({stem}-max); expected min <= max",
+                )
+                ok = False
+        if not ok:
+            return None
+        return Uncertainty(**{attr: tuple(v) for attr, v in fields.items()})  # type: ignore[arg-type]
+
+    @staticmethod
+    def convert(function: str, value: Fraction) -> float:
+        """A PDDL number (inches, degrees) in internal units (inches, radians)."""
+        if function in ANGLE_FUNCTIONS or function.endswith("dtheta"):
+            return PDDL_UNITS.angle_in(float(value))
+        return float(value)
+
+    def poses(
+        self, values: dict, kinds: dict[str, ObjectKind]
+    ) -> tuple[list[InitialObject], dict[str, tuple[float, float, float]]]:
+        initial: list[InitialObject] = []
+        obstacles: dict[str, tuple[float, float, float]] = {}
+        on_table = [key[1] for key, v in values.items() if key[0] == "on-table" and v is True]
+        for name, kind in kinds.items():
+            if kind is ObjectKind.OBSTACLE and name not in on_table:
+                on_table.append(name)
+        for name in on_table:
+            if name not in kinds:
+                continue
+            pose = []
+            for function in POSE_FUNCTIONS:
+                value = values.get((function, name))
+                if value is None and function == "theta":
+                    value = Fraction(0)
+                if value is None:
+                    self.error(
+                        f"init.{function}({name})",
+                        rf"\(\s*on-table\s+{re.escape(name)}\s*\)",
+                        f"{name} is on the table but has no ({function} {name}); expected its "
+                        f"nominal pose: (= (x {name}) ...) (= (y {name}) ...) and optionally "
+                        f"(= (theta {name}) ...) in degrees",
+                    )
+                    break
+                pose.append(self.convert(function, value))
+            if len(pose) != 3:
+                continue
+            if kinds[name] is ObjectKind.OBSTACLE:
+                obstacles[name] = (pose[0], pose[1], pose[2])
+                continue
+            spread = []
+            for function in SPREAD_FUNCTIONS:
+                value = values.get((function, name), Fraction(0))
+                if value < 0:
+                    self.error(
+                        f"init.{function}({name})",
+                        rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
+                        f"({function} {name}) is {num(float(value))}; expected a half-width >= 0",
+                    )
+                spread.append(self.convert(function, value))
+            initial.append(
+                InitialObject(name, (pose[0], pose[1], pose[2]), (spread[0], spread[1], spread[2]))
+            )
+        return initial, obstacles
+
+    # -- :goal -----------------------------------------------------------------------------
+    def goal(self, kinds: dict[str, ObjectKind]) -> Goal | None:
+        bounds: dict[str, dict[str, list[Fraction | None]]] = {}
+        references: set[str] = set()
+        functions_used: set[str] = set()
+        ok = True
+        for condition in _conjuncts(self.up.goals):
+            parsed = self.goal_condition(condition)
+            if parsed is None:
+                ok = False
+                continue
+            if parsed == "on-table":
+                continue
+            function, part, reference, low, high = parsed
+            functions_used.add(function)
+            if reference is not None:
+                references.add(reference)
+            slot = bounds.setdefault(part, {}).setdefault(function, [None, None])
+            if low is not None:
+                slot[0] = low if slot[0] is None else max(slot[0], low)
+            if high is not None:
+                slot[1] = high if slot[1] is None else min(slot[1], high)
+        if not ok:
+            return None
+        if not bounds:
+            self.error(
+                "goal",
+                r"\(\s*:goal",
+                "no goal intervals; expected (>= (x P) lo) (<= (x P) hi) and the same for y "
+                "(and theta) of each goal part, or rel-x/rel-y/rel-theta for a relative goal",
+            )
+            return None
+        relative = any(f.startswith("rel-") for f in functions_used)
+        if relative and any(not f.startswith("rel-") for f in functions_used):
+            self.error(
+                "goal",
+                r"\(\s*:goal",
+                "the goal mixes absolute (x, y, theta) and relative (rel-x, rel-y, rel-theta) "
+                "conditions; expected one kind",
+            )
+            return None
+        reference = None
+        if relative:
+            if len(references) != 1:
+                self.error(
+                    "goal",
+                    r"\(\s*:goal",
+                    f"a relative goal has one reference part; found {sorted(references)}",
+                )
+                return None
+            (reference,) = references
+            if kinds.get(reference) is not ObjectKind.PART:
+                self.error(
+                    "goal",
+                    rf"(?<![\w-]){re.escape(reference)}\s*\)",
+                    f"the reference {reference} of a relative goal must be a part",
+                )
+                return None
+        names = RELATIVE_FUNCTIONS if relative else POSE_FUNCTIONS
+        targets = []
+        tolerance: list[Fraction | None] | None = None
+        for part, dims in bounds.items():
+            if kinds.get(part) is not ObjectKind.PART:
+                kind = kinds.get(part)
+                self.error(
+                    f"goal.{part}",
+                    rf"\(\s*[\w-]+\s+{re.escape(part)}[\s)]",
+                    f"a goal for {part}, which is "
+                    f"{'not an object' if kind is None else 'a ' + kind.value}; only parts have "
+                    "goal poses",
+                )
+                ok = False
+                continue
+            if part == reference:
+                self.error(
+                    f"goal.{part}",
+                    "",
+                    f"{part} is the reference of the relative goal and cannot have a pose "
+                    "relative to itself",
+                )
+                ok = False
+                continue
+            target: list[Fraction] = []
+            half: list[Fraction | None] = []
+            for function in names:
+                low, high = dims.get(function, [None, None])
+                if low is None and high is None and function in ("theta", "rel-theta"):
+                    target.append(Fraction(0))
+                    half.append(None)
+                    continue
+                if low is None or high is None:
+                    missing = ">=" if low is None else "<="
+                    self.error(
+                        f"goal.{function}({part})",
+                        rf"\(\s*{function}\s+{re.escape(part)}[\s)]",
+                        f"({function} {part}) has no ({missing} ...) bound; expected both bounds "
+                        "of an interval target +- tolerance",
+                    )
+                    ok = False
+                    break
+                if low > high:
+                    self.error(
+                        f"goal.{function}({part})",
+                        rf"\(\s*{function}\s+{re.escape(part)}[\s)]",
+                        f"({function} {part}) must lie in [{num(float(low))}, "
+                        f"{num(float(high))}], an empty interval",
+                    )
+                    ok = False
+                    break
+                target.append((low + high) / 2)
+                half.append((high - low) / 2)
+            else:
+                if tolerance is None:
+                    tolerance = half
+                elif tolerance != half:
+                    self.error(
+                        f"goal.{part}",
+                        rf"\(\s*[\w-]+\s+{re.escape(part)}[\s)]",
+                        f"the goal interval of {part} has half-widths {_halves(half)}, another "
+                        f"part's have {_halves(tolerance)}; expected one tolerance for every "
+                        "goal part (an arrange-up problem has one)",
+                    )
+                    ok = False
+                    continue
+                targets.append(
+                    (
+                        part,
+                        (
+                            float(target[0]),
+                            float(target[1]),
+                            PDDL_UNITS.angle_in(float(target[2])),
+                        ),
+                    )
+                )
+        if not ok or tolerance is None:
+            return None
+        tol_theta = tolerance[2]
+        return Goal(
+            tuple(targets),
+            (
+                float(tolerance[0]),  # type: ignore[arg-type]
+                float(tolerance[1]),  # type: ignore[arg-type]
+                None if tol_theta is None else PDDL_UNITS.angle_in(float(tol_theta)),
+            ),
+            reference,
+        )
+
+    def goal_condition(self, condition: Any) -> Any:
+        """``"on-table"``, ``(function, part, reference, low, high)`` or ``None`` (reported)."""
+        if condition.is_fluent_exp() and condition.fluent().name == "on-table":
+            return "on-table"
+        if condition.is_le() or condition.is_lt() or condition.is_equals():
+            left, right = condition.args
+            if left.is_fluent_exp() and right.is_constant():
+                fluent, value, side = left, Fraction(right.constant_value()), "high"
+            elif right.is_fluent_exp() and left.is_constant():
+                fluent, value, side = right, Fraction(left.constant_value()), "low"
+            else:
+                fluent = None
+            if fluent is not None and fluent.fluent().name in POSE_FUNCTIONS + RELATIVE_FUNCTIONS:
+                function = fluent.fluent().name
+                args = [self.name(a.object().name) for a in fluent.args]
+                reference = args[1] if len(args) == 2 else None
+                if condition.is_equals():
+                    return function, args[0], reference, value, value
+                if side == "high":
+                    return function, args[0], reference, None, value
+                return function, args[0], reference, value, None
+        self.error(
+            "goal",
+            r"\(\s*:goal",
+            f"unsupported goal condition {condition}; expected (on-table P), (>= (x P) lo), "
+            "(<= (x P) hi) and likewise y, theta, or rel-x/rel-y/rel-theta of (P R)",
+        )
+        return None
+
+    # -- placement (the semantic checks of io.validation, shared with the YAML reader) --------
+    def check_placement(self, problem: ArrangementProblem) -> None:
+        placed = []
+        for spec in problem.obstacles:
+            assert spec.pose is not None  # an obstacle always has its fixed pose
+            placed.append(Placed(spec.name, spec.shape, spec.pose))
+        placed += [Placed(e.name, problem.object(e.name).shape, e.pose) for e in problem.initial]
+        width, depth = problem.table.size
+        for check in validation.check_placement(placed, problem.table.size):
+            name = check.name
+            if check.outside is not None:
+                xmin, ymin, xmax, ymax = check.outside
+                self.error(
+                    f"init.x({name})",
+                    rf"\(\s*x\s+{re.escape(name)}\s*\)",
+                    f"{name} lies outside the table: at its nominal pose it spans x "
+                    f"{num(xmin)}..{num(xmax)}, y {num(ymin)}..{num(ymax)}; expected it "
+                    f"within [0, {num(width)}] x [0, {num(depth)}] in",
+                )
+            for index, overlap in check.overlaps:
+                self.error(
+                    f"init.x({name})",
+                    rf"\(\s*x\s+{re.escape(name)}\s*\)",
+                    f"{name} overlaps {placed[index].name} at their nominal poses (overlap area "
+                    f"{num(overlap)} in²); expected shapes that touch at most",
+                )
+
+
+def _conjuncts(goals: Iterable[Any]) -> list[Any]:
+    out = []
+    stack = list(goals)[::-1]
+    while stack:
+        node = stack.pop()
+        if node.is_and():
+            stack.extend(list(node.args)[::-1])
+        else:
+            out.append(node)
+    return out
+
+
+def _halves(half: list[Fraction | None]) -> str:
+    return "[" + ", ".join("any" if h is None else num(float(h)) for h in half) + "]"
