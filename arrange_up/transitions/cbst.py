@@ -48,6 +48,7 @@ from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval,
 from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
+from arrange_up.cbst.model import load_model
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
@@ -85,8 +86,6 @@ class CBSTSemantics:
         workers: int = 1,
         model: str = "default",
     ) -> None:
-        from arrange_up.cbst.model import load_model
-
         self.problem = problem
         self.particles = 2
         self.seed = seed
