@@ -31,7 +31,7 @@ __all__ = [
     "PlanResult",
     "PlanStatistics",
     "ProgressCallback",
-    "SearchProgress",
+    "SearchSnapshot",
     "SearchStatus",
     "plan",
 ]
@@ -46,9 +46,9 @@ CANCELLED = SearchStatus.CANCELLED
 
 
 @dataclass(frozen=True)
-class SearchProgress:
-    """The search statistics of a planning run so far, as ``progress`` receives them (as the
-    dict of :meth:`to_json`).
+class SearchSnapshot:
+    """The search statistics of a planning run at one moment: during the search, ``progress``
+    receives them (as the dict of :meth:`to_json`); at its end they open :class:`PlanStatistics`.
 
     The counters are the search's (see :class:`~arrange_up.search.SearchStats`);
     ``transitions_simulated`` is the semantics' count of physics simulations (or model
@@ -67,7 +67,7 @@ class SearchProgress:
     elapsed: float
 
     @classmethod
-    def of(cls, search: SearchStats, transitions_simulated: int) -> SearchProgress:
+    def of(cls, search: SearchStats, transitions_simulated: int) -> SearchSnapshot:
         """The statistics of ``search``, with the semantics' ``transitions_simulated``."""
         return cls(
             expanded=search.expanded,
@@ -89,7 +89,7 @@ class SearchProgress:
 
 
 @dataclass(frozen=True)
-class PlanStatistics(SearchProgress):
+class PlanStatistics(SearchSnapshot):
     """The statistics of a finished planning run: the search's, ``elapsed`` the wall-clock
     seconds of the whole :func:`plan` call, and the configuration searched with."""
 
@@ -127,7 +127,7 @@ class PlanResult:
         return self.statistics.to_json()
 
 
-#: Receives ``SearchProgress.to_json()`` about every 0.2 s.
+#: Receives ``SearchSnapshot.to_json()`` every :data:`arrange_up.search.PROGRESS_INTERVAL` seconds.
 ProgressCallback = Callable[[dict[str, Any]], None]
 
 
@@ -201,8 +201,8 @@ def plan(
         ``tie_break`` alone only reorders the few goal-directed pushes of a belief. Plans stay
         valid plans of the unchanged problem.
     progress
-        Receives the search statistics so far (``SearchProgress.to_json()``) about every
-        0.2 s.
+        Receives the search statistics so far (``SearchSnapshot.to_json()``) every
+        :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end.
     should_stop
         Polled during the search; returning True cancels it (status ``cancelled``).
     """
@@ -223,7 +223,7 @@ def plan(
 
     def report(stats: SearchStats) -> None:
         if progress is not None:
-            progress(SearchProgress.of(stats, task.semantics.simulations).to_json())
+            progress(SearchSnapshot.of(stats, task.semantics.simulations).to_json())
 
     try:
         result = best_first_search(
@@ -244,7 +244,7 @@ def plan(
         task.close()
     statistics = PlanStatistics(
         **{
-            **asdict(SearchProgress.of(result.stats, task.semantics.simulations)),
+            **asdict(SearchSnapshot.of(result.stats, task.semantics.simulations)),
             "elapsed": time.monotonic() - started,
         },
         max_nodes=limit,

@@ -68,7 +68,7 @@ class CBSTSemantics:
 
     ``particles`` is 2: the planner sees an interval belief as its two corner
     pseudo-particles. ``seed`` and ``workers`` are accepted for the registry's signature and
-    unused (predictions are deterministic and take microseconds). ``model`` names the
+    unused (predictions are deterministic and run in this process). ``model`` names the
     learned model (a shipped name or a card path).
     """
 
