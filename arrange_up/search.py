@@ -90,13 +90,17 @@ A = TypeVar("A")
 PROGRESS_INTERVAL = 0.2
 
 
-class SearchStatus(enum.Enum):
-    """How a search ended."""
+class SearchStatus(enum.StrEnum):
+    """How a search ended.
+
+    A string enum: a member equals (and formats, and serialises as) its value, which is how
+    statuses are written in plan files and ``--json`` output (``"node-limit"``, ...).
+    """
 
     #: A goal state was popped; the result carries the plan.
     SOLVED = "solved"
     #: ``max_nodes`` expansions were done and another node was about to be expanded.
-    NODE_LIMIT = "node_limit"
+    NODE_LIMIT = "node-limit"
     #: The wall-clock ``timeout`` passed.
     TIMEOUT = "timeout"
     #: The open list ran empty: no plan exists under the pruning in force.

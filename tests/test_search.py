@@ -344,6 +344,17 @@ def test_node_limit(deferred: bool) -> None:
     assert not result.solved()
 
 
+def test_statuses_are_strings_with_the_plan_files_values() -> None:
+    assert [str(status) for status in SearchStatus] == [
+        "solved",
+        "node-limit",
+        "timeout",
+        "unsolvable",
+        "cancelled",
+    ]
+    assert SearchStatus.NODE_LIMIT == "node-limit" and SearchStatus("solved") is SearchStatus.SOLVED
+
+
 def test_goal_found_when_limit_exactly_suffices() -> None:
     # Reaching 3 on the line with h = distance takes 3 expansions (0, 1, 2).
     h = lambda n: float(abs(3 - n))  # noqa: E731

@@ -47,7 +47,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from arrange_up.experiments.planning import Progress, _csv_appender, _done_keys, _read
+from matplotlib.patches import Patch
+
+from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
+from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
+from arrange_up.figures.backend import pyplot
+from arrange_up.io.domains import load
+from arrange_up.model.world import Push
+from arrange_up.parallel import available_cores
+from arrange_up.repair import METHODS, nominal_plans, repair_plan
 
 __all__ = [
     "CSV_NAME",
@@ -150,11 +158,6 @@ def fixture_experiment(
     Raises ``ValueError`` for bad sizes, :class:`StaleResultsError` (see module docstring),
     and whatever the evaluation raises for a bad backend.
     """
-    from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
-    from arrange_up.io.domains import load
-    from arrange_up.parallel import available_cores
-    from arrange_up.repair import METHODS, nominal_plans
-
     if plans < 1:
         raise ValueError(f"plans must be at least 1, got {plans!r}")
     if not particles or any(n < 1 for n in particles):
@@ -166,9 +169,9 @@ def fixture_experiment(
     workers = workers or available_cores()
     tries = max_tries if max_tries is not None else 10 * max(plans, 20) + 10
     path = Path(output_dir) / CSV_NAME
-    existing = _read(path) if path.exists() else []
+    existing = read_csv(path) if path.exists() else []
     _check_columns(path)
-    done = _done_keys(path, _KEY)
+    done = done_keys(path, _KEY)
     say = progress or (lambda _msg: None)
 
     def evaluate(problem: Any, actions: Sequence[Any], what: str) -> dict[str, Any]:
@@ -195,7 +198,7 @@ def fixture_experiment(
             **{kind: getattr(result.failures, kind) for kind in FAILURE_KINDS},
         }
 
-    with _csv_appender(path, FIXTURE_FIELDS) as append:
+    with CsvAppender(path, FIXTURE_FIELDS) as append:
 
         def write(row: dict[str, Any]) -> None:
             append(row)
@@ -260,7 +263,12 @@ def fixture_experiment(
                         row.update(evaluate(problem, repaired, what))
                     write(row)
     selected = select_rows(
-        _read(path), problems=problems, plans=plans, particles=particles, seed=seed, method=method
+        read_csv(path),
+        problems=problems,
+        plans=plans,
+        particles=particles,
+        seed=seed,
+        method=method,
     )
     plot_fixture_experiment(selected, Path(output_dir))
     return path
@@ -268,7 +276,7 @@ def fixture_experiment(
 
 def read_rows(path: Path) -> list[dict[str, str]]:
     """The rows of a ``fixtures.csv`` as dicts of strings (empty cells are ``""``)."""
-    return _read(path)
+    return read_csv(path)
 
 
 def select_rows(
@@ -334,8 +342,6 @@ def _row(base: dict[str, Any], **values: Any) -> dict[str, Any]:
 
 
 def _pushes(actions: Iterable[Any]) -> int:
-    from arrange_up.model.world import Push
-
     return sum(1 for a in actions if isinstance(a, Push))
 
 
@@ -351,8 +357,6 @@ def _repair_row(
     digest: str,
 ) -> dict[str, Any]:
     """One repair as a row; the repaired actions ride along under ``_actions`` (not a column)."""
-    from arrange_up.repair import repair_plan
-
     started = time.perf_counter()
     try:
         result = repair_plan(
@@ -455,12 +459,12 @@ def summarize(rows: Sequence[dict[str, str]]) -> list[SummaryRow]:
                     plans=len(group),
                     solved=len(solved),
                     evaluated=len(rates),
-                    reliability=_mean(rates),
+                    reliability=mean(rates),
                     low=min(rates, default=math.nan),
                     high=max(rates, default=math.nan),
-                    seconds=_mean(float(r["seconds"]) for r in solved),
-                    length=_mean(float(r["plan_length"]) for r in solved),
-                    fixtures=_mean(float(r["fixtures_placed"]) for r in solved),
+                    seconds=mean(float(r["seconds"]) for r in solved),
+                    length=mean(float(r["plan_length"]) for r in solved),
+                    fixtures=mean(float(r["fixtures_placed"]) for r in solved),
                     statuses=tuple(sorted(others.items())),
                     failures=tuple(
                         sum(int(r[kind]) for r in solved if r["reliability"] != "")
@@ -516,11 +520,7 @@ def plot_fixture_experiment(rows: Sequence[dict[str, str]], output_dir: Path) ->
 
 
 def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path) -> Path:
-    from matplotlib.patches import Patch
-
-    from arrange_up.figures.render import _plt
-
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4))
     width = 0.38
     used: set[int] = set()
@@ -567,9 +567,7 @@ def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path
 
 
 def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
-    from arrange_up.figures.render import _plt
-
-    plt = _plt()
+    plt = pyplot()
     nominal = rows[0]
     repaired = [s for s in rows if s.particles is not None]
     fig, (ax_rel, ax_time) = plt.subplots(1, 2, figsize=(11, 4))
@@ -648,11 +646,6 @@ def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
     fig.savefig(png, dpi=120)
     plt.close(fig)
     return png
-
-
-def _mean(values: Iterable[float]) -> float:
-    values = list(values)
-    return sum(values) / len(values) if values else math.nan
 
 
 def _fmt(value: float, spec: str) -> str:

@@ -14,14 +14,19 @@ summary. Sizes scale down by arguments (the CLI's flags).
 
 from __future__ import annotations
 
-import csv
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-Progress = Callable[[str], None]
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
+from arrange_up.figures.backend import pyplot
+from arrange_up.io.domains import load
+from arrange_up.parallel import available_cores
+from arrange_up.planning.planner import plan
+from arrange_up.transitions import available
 
 TRANSITION_FIELDS = [
     "problem",
@@ -68,8 +73,6 @@ class Planner:
 
 def default_planners(particle_counts: Iterable[int] = (5, 25, 50)) -> list[Planner]:
     """Deterministic, particles with each count, and every other registered semantics."""
-    from arrange_up.transitions import available
-
     planners = [Planner("deterministic", "deterministic", 1)]
     planners += [Planner(f"particles-{n}", "particles", n) for n in particle_counts]
     planners += [
@@ -91,17 +94,12 @@ def transition_comparison(
     progress: Progress | None = None,
 ) -> Path:
     """Run (or resume) the transition comparison; returns the CSV path. See module doc."""
-    from arrange_up.evaluation.evaluate import evaluate_plan
-    from arrange_up.io.domains import load
-    from arrange_up.parallel import available_cores
-    from arrange_up.planning.planner import plan
-
     workers = workers or available_cores()
     planners = list(planners or default_planners())
     path = Path(output_dir) / "transition-comparison.csv"
-    done = _done_keys(path, ("problem", "planner", "run"))
+    done = done_keys(path, ("problem", "planner", "run"))
     say = progress or (lambda _msg: None)
-    with _csv_appender(path, TRANSITION_FIELDS) as write:
+    with CsvAppender(path, TRANSITION_FIELDS) as write:
         for name in problems:
             problem = load(name)
             for planner in planners:
@@ -173,13 +171,10 @@ def search_table(
     progress: Progress | None = None,
 ) -> Path:
     """Run (or resume) the search table (A*, weight 1, as in the thesis); returns the CSV."""
-    from arrange_up.io.domains import load
-    from arrange_up.planning.planner import plan
-
     path = Path(output_dir) / "search-table.csv"
-    done = _done_keys(path, ("search", "domination", "problem", "semantics"))
+    done = done_keys(path, ("search", "domination", "problem", "semantics"))
     say = progress or (lambda _msg: None)
-    with _csv_appender(path, SEARCH_FIELDS) as write:
+    with CsvAppender(path, SEARCH_FIELDS) as write:
         for label, heuristic in SEARCH_TYPES:
             for domination in (False, True):
                 for name in problems:
@@ -221,20 +216,18 @@ def search_table(
 # -- plots ---------------------------------------------------------------------------------------
 def plot_transition_comparison(csv_path: Path, png_path: Path) -> Path:
     """Bar charts of mean planning time and mean reliability per planner and problem."""
-    from arrange_up.figures.render import _plt
-
-    rows = _read(csv_path)
+    rows = read_csv(csv_path)
     problems = sorted({r["problem"] for r in rows})
     planners = list(dict.fromkeys(r["planner"] for r in rows))
-    plt = _plt()
+    plt = pyplot()
     fig, (ax_time, ax_rel) = plt.subplots(1, 2, figsize=(11, 4))
     width = 0.8 / max(1, len(planners))
     for j, planner in enumerate(planners):
         times, rels = [], []
         for problem in problems:
             sel = [r for r in rows if r["problem"] == problem and r["planner"] == planner]
-            times.append(_mean(float(r["planning_seconds"]) for r in sel))
-            rels.append(100 * _mean(float(r["reliability"]) for r in sel if r["reliability"]))
+            times.append(mean(float(r["planning_seconds"]) for r in sel))
+            rels.append(100 * mean(float(r["reliability"]) for r in sel if r["reliability"]))
         xs = [i + j * width for i in range(len(problems))]
         ax_time.bar(xs, times, width, label=planner)
         ax_rel.bar(xs, rels, width, label=planner)
@@ -257,11 +250,9 @@ def plot_transition_comparison(csv_path: Path, png_path: Path) -> Path:
 def plot_search_table(csv_path: Path, png_path: Path, semantics: str) -> Path:
     """Nodes expanded per problem for each search type and domination setting (log scale),
     for the rows of one semantics."""
-    from arrange_up.figures.render import _plt
-
-    rows = [r for r in _read(csv_path) if r["semantics"] == semantics]
+    rows = [r for r in read_csv(csv_path) if r["semantics"] == semantics]
     problems = list(dict.fromkeys(r["problem"] for r in rows))
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4))
     for label, _ in SEARCH_TYPES:
         for domination, style in (("no", "--"), ("yes", "-")):
@@ -285,45 +276,3 @@ def plot_search_table(csv_path: Path, png_path: Path, semantics: str) -> Path:
     fig.savefig(png_path, dpi=120)
     plt.close(fig)
     return png_path
-
-
-# -- CSV helpers -----------------------------------------------------------------------------------
-def _read(path: Path) -> list[dict[str, str]]:
-    with Path(path).open(newline="") as handle:
-        return list(csv.DictReader(handle))
-
-
-def _done_keys(path: Path, fields: Sequence[str]) -> set[tuple[str, ...]]:
-    if not path.exists():
-        return set()
-    return {tuple(row[f] for f in fields) for row in _read(path)}
-
-
-class _csv_appender:  # noqa: N801 - used as a context manager like open()
-    """Append rows to a CSV (header written once), flushing after every row."""
-
-    def __init__(self, path: Path, fields: Sequence[str]) -> None:
-        self.path = Path(path)
-        self.fields = list(fields)
-
-    def __enter__(self) -> Callable[[dict[str, Any]], None]:
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        new = not self.path.exists() or self.path.stat().st_size == 0
-        self.handle = self.path.open("a", newline="")
-        self.writer = csv.DictWriter(self.handle, self.fields)
-        if new:
-            self.writer.writeheader()
-
-        def write(row: dict[str, Any]) -> None:
-            self.writer.writerow(row)
-            self.handle.flush()
-
-        return write
-
-    def __exit__(self, *exc: object) -> None:
-        self.handle.close()
-
-
-def _mean(values: Iterable[float]) -> float:
-    values = list(values)
-    return sum(values) / len(values) if values else float("nan")

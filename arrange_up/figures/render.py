@@ -14,9 +14,8 @@ panel per plan action, a report) can reuse them:
 * :func:`draw_goal`: an absolute goal's target outlines and tolerance regions, or a relative
   goal's arrangement around the reference part.
 
-Everything is in inches (the problem's internal unit), whatever units the file used.
-matplotlib is imported inside the functions (with the non-interactive Agg backend), so importing
-this module is cheap.
+Everything is in inches (the problem's internal unit), whatever units the file used. Figures
+are drawn with the non-interactive Agg backend (:func:`arrange_up.figures.backend.pyplot`).
 """
 
 from __future__ import annotations
@@ -24,13 +23,23 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.axes import Axes
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Rectangle
+from matplotlib.patches import Polygon as PolygonPatch
+from shapely.geometry import Polygon
+
+from arrange_up.figures.backend import pyplot
+from arrange_up.geometry import shapes as geometry
+from arrange_up.io.domains import first_sentence
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, ObjectSpec, Pose
-
-if TYPE_CHECKING:
-    from matplotlib.axes import Axes
-    from matplotlib.figure import Figure
 
 __all__ = [
     "PART_COLORS",
@@ -81,16 +90,6 @@ TOLERANCE_ALPHA = 0.14
 # ---------------------------------------------------------------------------------------------
 # small helpers
 # ---------------------------------------------------------------------------------------------
-def _plt() -> Any:
-    """matplotlib.pyplot with the Agg backend, imported on first use."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def object_color(problem: ArrangementProblem, name: str) -> str:
     """The colour ``name`` is drawn in: parts get :data:`PART_COLORS` in declaration order;
     fixtures, manipulators and obstacles a colour per kind."""
@@ -122,8 +121,6 @@ def _compose(reference: Pose, relative: Pose) -> Pose:
 def _rings(geom: Any) -> list[Any]:
     """The exterior rings (coordinate lists) of a shapely geometry's polygons (a footprint is
     already the union of its convex parts, so a non-convex part has one outline)."""
-    from shapely.geometry import Polygon
-
     if isinstance(geom, Polygon):
         polygons = [geom]
     else:
@@ -132,8 +129,6 @@ def _rings(geom: Any) -> list[Any]:
 
 
 def _polygon_patches(geom: Any, **style: Any) -> list[Any]:
-    from matplotlib.patches import Polygon as PolygonPatch
-
     return [PolygonPatch(ring, closed=True, **style) for ring in _rings(geom)]
 
 
@@ -166,10 +161,6 @@ def draw_table(ax: Axes, problem: ArrangementProblem, *, obstacles: bool = True)
     :data:`WALL_DRAW_THICKNESS`; an edge without a wall is drawn as a thin dashed line (a part
     pushed across it falls off). Returns the artists added.
     """
-    from matplotlib.patches import Rectangle
-
-    from arrange_up.geometry import shapes as geometry
-
     width, depth = problem.table.size
     artists: list[Any] = [
         ax.add_patch(
@@ -237,8 +228,6 @@ def draw_object(
     ``label_size`` points (by default a size that fits the footprint's width at
     :data:`POINTS_PER_INCH`). Returns the artists added.
     """
-    from arrange_up.geometry import shapes as geometry
-
     geom = geometry.footprint(spec.shape.parts, pose)
     if fill:
         style = {
@@ -294,10 +283,6 @@ def draw_shadows(
     axis-aligned bounding box a dashed rectangle (``box``); both in ``color``. Nothing is drawn
     for zero half-widths (the shadow is the footprint itself). Returns the artists added.
     """
-    from matplotlib.patches import Rectangle
-
-    from arrange_up.geometry import shapes as geometry
-
     if _is_zero(half_widths):
         return []
     artists: list[Any] = []
@@ -375,8 +360,6 @@ def draw_goal(
 def _draw_target(
     ax: Axes, problem: ArrangementProblem, name: str, target: Pose, *, tolerance: bool
 ) -> list[Any]:
-    from matplotlib.patches import Rectangle
-
     spec = problem.object(name)
     color = object_color(problem, name)
     half = goal_tolerance_half_widths(problem)
@@ -474,9 +457,6 @@ def off_table_note(problem: ArrangementProblem) -> str:
 def draw_legend(ax: Axes, problem: ArrangementProblem, **kwargs: Any) -> Any:
     """A legend explaining the layers present in ``problem``'s picture (proxy artists, so it
     works whatever was drawn). ``kwargs`` go to ``ax.legend``."""
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
     sample = PART_COLORS[0]
     handles: list[Any] = []
     if problem.table.walls:
@@ -531,8 +511,6 @@ def _limits(boxes: Iterable[tuple[float, float, float, float]], margin: float) -
 
 def _problem_bounds(problem: ArrangementProblem) -> list[tuple[float, float, float, float]]:
     """Boxes everything on the table picture fits in: table, walls, shadows, goal regions."""
-    from arrange_up.geometry import shapes as geometry
-
     width, depth = problem.table.size
     pad = WALL_DRAW_THICKNESS
     boxes = [(-pad, -pad, width + pad, depth + pad)]
@@ -548,8 +526,6 @@ def _problem_bounds(problem: ArrangementProblem) -> list[tuple[float, float, flo
 
 
 def _relative_bounds(problem: ArrangementProblem) -> list[tuple[float, float, float, float]]:
-    from arrange_up.geometry import shapes as geometry
-
     goal = problem.goal
     assert goal.reference is not None
     reference = problem.object(goal.reference).shape.parts
@@ -576,8 +552,7 @@ def problem_figure(problem: ArrangementProblem, *, title: str | None = None) -> 
 
     The caller owns the figure (close it with ``matplotlib.pyplot.close(fig)``).
     """
-    plt = _plt()
-    from arrange_up.io.domains import first_sentence
+    plt = pyplot()
 
     relative = problem.goal.is_relative
     (x0, x1), (y0, y1) = _limits(_problem_bounds(problem), 0.4)
@@ -657,7 +632,7 @@ def draw_problem(
     parts at their relative poses. Objects that start off the table are listed in a side note.
     ``title`` replaces the default title (the problem's name and first sentence).
     """
-    plt = _plt()
+    plt = pyplot()
     output = Path(output)
     if output.parent != Path(""):
         output.parent.mkdir(parents=True, exist_ok=True)
@@ -711,12 +686,6 @@ def draw_heatmap(
 
     Returns the artists added (the colour bar's axes excluded).
     """
-    import numpy as np
-    from matplotlib import colormaps
-    from matplotlib.colors import Normalize
-
-    from arrange_up.geometry import shapes as geometry
-
     artists: list[Any] = list(draw_table(ax, problem))
     colors = {p.name: object_color(problem, p.name) for p in problem.parts}
     before = scores.nominal_state.as_dict()
@@ -845,8 +814,6 @@ def draw_heatmap(
             zorder=4.5,
         )
     if colorbar:
-        from matplotlib.cm import ScalarMappable
-
         mappable = ScalarMappable(norm=norm, cmap=colormap)
         mappable.set_array(np.array([]))
         bar = ax.figure.colorbar(mappable, ax=ax, shrink=0.8, pad=0.02)
@@ -859,10 +826,7 @@ def heatmap_figure(
 ) -> Figure:
     """A figure with :func:`draw_heatmap` of ``scores`` and a summary; ``kwargs`` go to
     :func:`draw_heatmap`. The caller owns the figure (close it with ``plt.close(fig)``)."""
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
-    plt = _plt()
+    plt = pyplot()
     width, depth = problem.table.size
     fig, ax = plt.subplots(
         figsize=(8.8, 7.0 * depth / max(width, 1e-9) + 0.6), layout="constrained"
@@ -928,7 +892,7 @@ def write_heatmap(
     **kwargs: Any,
 ) -> Path:
     """Save :func:`heatmap_figure` of ``scores`` as a PNG at ``output``; returns the path."""
-    plt = _plt()
+    plt = pyplot()
     output = Path(output)
     if output.parent != Path(""):
         output.parent.mkdir(parents=True, exist_ok=True)

@@ -22,8 +22,21 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from arrange_up.evaluation.evaluate import trace_rollout
+from arrange_up.figures import render
+from arrange_up.figures.backend import pyplot
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
-from arrange_up.model.world import Action, Pick, Place, Push, WorldState
+from arrange_up.model.world import (
+    Action,
+    Pick,
+    Place,
+    Push,
+    WorldState,
+    nominal_initial_state,
+    nominal_noise,
+)
+from arrange_up.physics.simulation import simulate
+from arrange_up.transitions import make_semantics
 
 ROLLOUT_COLOR = "0.35"
 ROLLOUT_ALPHA = 0.07
@@ -47,11 +60,6 @@ def storyboard_data(
     ``None`` where it made no prediction) and ``rollouts`` (for each rollout, its states, cut
     short where it failed).
     """
-    from arrange_up.evaluation.evaluate import trace_rollout
-    from arrange_up.model.world import nominal_initial_state, nominal_noise
-    from arrange_up.physics.simulation import simulate
-    from arrange_up.transitions import make_semantics
-
     nominal: list[WorldState | None] = [nominal_initial_state(problem)]
     for action in actions:
         state = nominal[-1]
@@ -95,8 +103,6 @@ def draw_storyboard(
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
     """Draw the storyboard of a plan into a PNG (see the module docstring)."""
-    from arrange_up.figures import render
-
     data = storyboard_data(
         problem,
         actions,
@@ -107,7 +113,7 @@ def draw_storyboard(
         plan_seed=plan_seed,
         progress=progress,
     )
-    plt = render._plt()
+    plt = pyplot()
     panels = len(actions) + 1
     columns = max(1, min(columns, panels))
     rows = math.ceil(panels / columns)
@@ -141,8 +147,6 @@ def draw_storyboard(
 
 
 def _draw_panel(ax, problem: ArrangementProblem, data, actions, k: int) -> None:
-    from arrange_up.figures import render
-
     render.draw_table(ax, problem)
     if not problem.goal.is_relative:
         for artist in render.draw_goal(ax, problem, tolerance=False):
@@ -190,8 +194,6 @@ def _draw_panel(ax, problem: ArrangementProblem, data, actions, k: int) -> None:
 
 
 def _draw_action(ax, problem: ArrangementProblem, action: Action) -> None:
-    from arrange_up.figures import render
-
     if isinstance(action, Place):
         spec = problem.object(action.obj)
         render.draw_object(

@@ -20,12 +20,11 @@ With ``unclipped_pushes`` (the planner sets it for semantics that refuse uncerta
 i.e. CBST), when that position *clips* a shadow ahead (its long side overlaps the shadow's side
 without covering it whole, so whether it touches that part is uncertain), the same push is
 offered a second time from the nearest position that misses or wholly covers every shadow
-ahead. The first position keeps plans that move a neighbouring row along (CBST's blocks-7 plan
-needs it); the second makes contacts certain where CBST must refuse a clipped one (without it, a
-plain row of four blocks against a wall had no CBST plan: each new block's push down clipped
-the block beside it). Particle semantics simulate clipped contacts, and for them the extra
-pushes only widen the search (25-particle blocks-7 then ran out of nodes in 2 of 3 seeds), so
-it is off by default.
+ahead. The first position keeps plans that move a neighbouring row along; the second makes
+contacts certain where CBST must refuse a clipped one (a row of blocks built against a wall,
+where each new block's push down clips the block beside it). Particle semantics simulate
+clipped contacts, and for them the extra pushes only widen the search, so it is off by default
+(the cases that motivate both positions are in docs/design/planning.md).
 Distances:
 
 * to the wall ahead (the controller stalls when the train of parts is compressed against it),

@@ -9,19 +9,94 @@ status.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.model.world import Action, Push
+from arrange_up.model.world import Action
+from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
+from arrange_up.search import SearchStats, SearchStatus, best_first_search
 
-#: Statuses of a planning run, as they appear in plan files and ``--json`` output.
-SOLVED = "solved"
-NODE_LIMIT = "node-limit"
-TIMEOUT = "timeout"
-UNSOLVABLE = "unsolvable"
-CANCELLED = "cancelled"
+__all__ = [
+    "CANCELLED",
+    "DEFAULT_MAX_NODES",
+    "DEFAULT_WEIGHT",
+    "NODE_LIMIT",
+    "SOLVED",
+    "TIMEOUT",
+    "UNSOLVABLE",
+    "VARIETY_SPLIT",
+    "PlanResult",
+    "PlanStatistics",
+    "ProgressCallback",
+    "SearchSnapshot",
+    "SearchStatus",
+    "plan",
+]
+
+#: The statuses of a planning run are those of the search (a string enum: ``"solved"``,
+#: ``"node-limit"``, ...); these names are kept for the callers that import them from here.
+SOLVED = SearchStatus.SOLVED
+NODE_LIMIT = SearchStatus.NODE_LIMIT
+TIMEOUT = SearchStatus.TIMEOUT
+UNSOLVABLE = SearchStatus.UNSOLVABLE
+CANCELLED = SearchStatus.CANCELLED
+
+
+@dataclass(frozen=True)
+class SearchSnapshot:
+    """The search statistics of a planning run at one moment: during the search, ``progress``
+    receives them (as the dict of :meth:`to_json`); at its end they open :class:`PlanStatistics`.
+
+    The counters are the search's (see :class:`~arrange_up.search.SearchStats`);
+    ``transitions_simulated`` is the semantics' count of physics simulations (or model
+    predictions); ``best_h`` is None until a finite heuristic value was seen.
+    """
+
+    expanded: int
+    generated: int
+    evaluated: int
+    pruned_dominated: int
+    pruned_infinite: int
+    pruned_duplicate: int
+    no_prediction: int
+    transitions_simulated: int
+    best_h: float | None
+    elapsed: float
+
+    @classmethod
+    def of(cls, search: SearchStats, transitions_simulated: int) -> SearchSnapshot:
+        """The statistics of ``search``, with the semantics' ``transitions_simulated``."""
+        return cls(
+            expanded=search.expanded,
+            generated=search.generated,
+            evaluated=search.evaluated,
+            pruned_dominated=search.pruned_dominated,
+            pruned_infinite=search.pruned_infinite,
+            pruned_duplicate=search.pruned_duplicate,
+            no_prediction=search.no_prediction,
+            transitions_simulated=transitions_simulated,
+            # JSON has no infinity: "no finite heuristic value seen yet" is None.
+            best_h=search.best_h if math.isfinite(search.best_h) else None,
+            elapsed=search.elapsed,
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """The statistics as a JSON object, keys in field order (as plan files store them)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+@dataclass(frozen=True)
+class PlanStatistics(SearchSnapshot):
+    """The statistics of a finished planning run: the search's, ``elapsed`` the wall-clock
+    seconds of the whole :func:`plan` call, and the configuration searched with."""
+
+    max_nodes: int
+    heuristic: str
+    dominance: bool
+    weight: float
 
 
 @dataclass(frozen=True)
@@ -29,24 +104,30 @@ class PlanResult:
     """The outcome of :func:`plan`.
 
     ``actions`` (internal units) and ``beliefs`` (the predicted belief before the first action
-    and after each action, for storyboards) are set iff ``status == "solved"``. ``stats`` holds
-    the search statistics (expanded, generated, evaluated, pruned counts, transitions simulated,
-    elapsed seconds, ...).
+    and after each action, for storyboards) are set iff ``status == "solved"``.
+    ``statistics`` holds the search statistics; :attr:`stats` is their JSON form.
     """
 
-    status: str
+    status: SearchStatus
     actions: tuple[Action, ...] | None
     semantics: str
     seed: int
     particles: int
-    stats: dict[str, Any] = field(default_factory=dict)
+    statistics: PlanStatistics
     beliefs: tuple[Any, ...] | None = None
 
     @property
     def solved(self) -> bool:
-        return self.status == SOLVED
+        return self.status == SearchStatus.SOLVED
+
+    @property
+    def stats(self) -> dict[str, Any]:
+        """``statistics.to_json()``: the dict plan files and ``--json`` output store, kept as
+        the form callers index (``result.stats["expanded"]``)."""
+        return self.statistics.to_json()
 
 
+#: Receives ``SearchSnapshot.to_json()`` every :data:`arrange_up.search.PROGRESS_INTERVAL` seconds.
 ProgressCallback = Callable[[dict[str, Any]], None]
 
 
@@ -54,9 +135,9 @@ DEFAULT_MAX_NODES = 5000
 """The thesis's node limit (§3.3)."""
 DEFAULT_WEIGHT = 2.0
 """Weighted A* by default: with the (already inadmissible) per-dimension count, A* spends most
-of its nodes on plateaus of equal f; weight 2 found the 50-particle 7-block plan within the
-node limit (3,303 nodes) where A* did not, and cut 50-particle blocks-4 from 766 nodes to 50,
-for plans one or two actions longer. ``weight=1`` gives the thesis's A*."""
+of its nodes on plateaus of equal f, and weight 2 solves within the node limit problems A* does
+not, for plans an action or two longer (figures in docs/design/planning.md). ``weight=1`` gives
+the thesis's A*."""
 
 
 def plan(
@@ -120,55 +201,39 @@ def plan(
         ``tie_break`` alone only reorders the few goal-directed pushes of a belief. Plans stay
         valid plans of the unchanged problem.
     progress
-        Receives a dict of search statistics about every 0.2 s.
+        Receives the search statistics so far (``SearchSnapshot.to_json()``) every
+        :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end.
     should_stop
         Polled during the search; returning True cancels it (status ``cancelled``).
     """
-    import time
-
-    from arrange_up.belief.goals import GoalTest
-    from arrange_up.belief.states import IntervalDominanceIndex, ParticleBelief
-    from arrange_up.geometry.collision import CollisionChecker
-    from arrange_up.planning.actions import ActionGenerator
-    from arrange_up.planning.heuristics import make_heuristic
-    from arrange_up.search import Edge, SearchStatus, best_first_search
-    from arrange_up.transitions import make_semantics
-
     started = time.monotonic()
     limit = (
         max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)
     )
-    model = make_semantics(semantics, problem, particles=particles, seed=seed, workers=workers)
-    checker = CollisionChecker(problem)
-    goal = GoalTest(problem)
-    generator = ActionGenerator(
-        problem, checker, unclipped_pushes=getattr(model, "refuses_uncertain_contacts", False)
+    task = BeliefTask.build(
+        problem,
+        semantics=semantics,
+        particles=particles,
+        seed=seed,
+        workers=workers,
+        heuristic=heuristic,
+        dominance=dominance,
+        variety=variety,
     )
-    h = make_heuristic(heuristic, problem, goal, checker, generator)
 
-    def successors(belief: ParticleBelief):
-        for action in generator.candidates(belief.intervals):
-            if variety and isinstance(action, Push):
-                action = _vary_push(action, belief, seed)
-            yield Edge(action, 1.0, _bind(model.apply, belief, action))
-
-    def is_goal(belief: ParticleBelief) -> bool:
-        return goal.satisfied_array(belief.poses, belief.names())
-
-    def report(stats) -> None:
+    def report(stats: SearchStats) -> None:
         if progress is not None:
-            progress(_stats_dict(stats, model))
+            progress(SearchSnapshot.of(stats, task.semantics.simulations).to_json())
 
     try:
-        start = model.initial_belief()
         result = best_first_search(
-            start,
-            successors,
-            is_goal,
-            h,
+            task.initial_belief(),
+            task.successors,
+            task.is_goal,
+            task.heuristic,
             weight=weight,
             deferred=deferred,
-            dominance_index=IntervalDominanceIndex() if dominance else None,
+            dominance_index=task.dominance_index(),
             max_nodes=limit,
             timeout=None if timeout is None else max(0.0, timeout - (time.monotonic() - started)),
             tie_break_seed=seed if tie_break else None,
@@ -176,66 +241,23 @@ def plan(
             should_stop=should_stop,
         )
     finally:
-        model.close()
-    status = {
-        SearchStatus.SOLVED: SOLVED,
-        SearchStatus.NODE_LIMIT: NODE_LIMIT,
-        SearchStatus.TIMEOUT: TIMEOUT,
-        SearchStatus.UNSOLVABLE: UNSOLVABLE,
-        SearchStatus.CANCELLED: CANCELLED,
-    }[result.status]
-    stats = _stats_dict(result.stats, model)
-    stats["elapsed"] = time.monotonic() - started
-    stats["max_nodes"] = limit
-    stats["heuristic"] = heuristic
-    stats["dominance"] = dominance
-    stats["weight"] = weight
+        task.close()
+    statistics = PlanStatistics(
+        **{
+            **asdict(SearchSnapshot.of(result.stats, task.semantics.simulations)),
+            "elapsed": time.monotonic() - started,
+        },
+        max_nodes=limit,
+        heuristic=heuristic,
+        dominance=dominance,
+        weight=weight,
+    )
     return PlanResult(
-        status=status,
+        status=result.status,
         actions=tuple(result.plan) if result.plan is not None else None,
-        semantics=model.name,
+        semantics=task.semantics.name,
         seed=seed,
-        particles=model.particles,
-        stats=stats,
+        particles=task.semantics.particles,
+        statistics=statistics,
         beliefs=tuple(result.states) if result.states is not None else None,
     )
-
-
-#: Probability that ``variety`` offers a push cut short instead of whole.
-VARIETY_SPLIT = 0.5
-
-
-def _vary_push(push: Push, belief: Any, seed: int) -> Push:
-    """``push`` as ``variety`` offers it: whole, or cut to 40-80% of its distance, drawn from
-    ``(seed, belief, push)`` (see :func:`plan`)."""
-    import dataclasses
-    import hashlib
-
-    import numpy as np
-
-    key = repr((belief.names(), belief.poses.tolist(), push)).encode()
-    digest = int.from_bytes(hashlib.blake2b(key, digest_size=8).digest(), "little")
-    rng = np.random.default_rng([seed, 0x7A41E7, digest])
-    if rng.random() >= VARIETY_SPLIT:
-        return push
-    return dataclasses.replace(push, distance=round(push.distance * rng.uniform(0.4, 0.8), 4))
-
-
-def _bind(apply: Callable[[Any, Any], Any], belief: Any, action: Any) -> Callable[[], Any]:
-    return lambda: apply(belief, action)
-
-
-def _stats_dict(stats: Any, model: Any) -> dict[str, Any]:
-    return {
-        "expanded": stats.expanded,
-        "generated": stats.generated,
-        "evaluated": stats.evaluated,
-        "pruned_dominated": stats.pruned_dominated,
-        "pruned_infinite": stats.pruned_infinite,
-        "pruned_duplicate": stats.pruned_duplicate,
-        "no_prediction": stats.no_prediction,
-        "transitions_simulated": model.simulations,
-        # JSON has no infinity: "no finite heuristic value seen yet" is written as null.
-        "best_h": stats.best_h if math.isfinite(stats.best_h) else None,
-        "elapsed": stats.elapsed,
-    }

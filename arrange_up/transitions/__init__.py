@@ -14,6 +14,7 @@ New semantics register themselves with :func:`register`.
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -24,15 +25,27 @@ from arrange_up.model.world import Action
 class Semantics(Protocol):
     """What the planner needs from a transition semantics.
 
-    A semantics may also set ``refuses_uncertain_contacts = True`` (read with ``getattr``,
-    default False) when it cannot predict a push whose manipulator may or may not touch a part
-    (CBST does so): the planner then also proposes pushes from manipulator positions that miss
-    or wholly cover every part ahead (see :mod:`arrange_up.planning.actions`).
+    Attributes
+    ----------
+    name
+        The name the semantics is registered under.
+    particles
+        Particles per belief it actually uses.
+    simulations
+        Physics simulations (or model predictions) run so far: the "transitions simulated"
+        statistic.
+    refuses_uncertain_contacts
+        True when the semantics cannot predict a push whose manipulator may or may not touch a
+        part (CBST): the planner then also proposes pushes from manipulator positions that
+        miss or wholly cover every part ahead (see :mod:`arrange_up.planning.actions`). False
+        for a semantics that predicts every push (``particles``, ``deterministic``); a class
+        that subclasses this protocol inherits False.
     """
 
     name: str
     particles: int
-    simulations: int  # physics simulations run so far (the "transitions simulated" statistic)
+    simulations: int
+    refuses_uncertain_contacts: bool = False
 
     def initial_belief(self) -> Any: ...
 
@@ -50,7 +63,11 @@ _REGISTRY: dict[str, tuple[str, str]] = {
 
 
 def register(name: str, module: str, attribute: str) -> None:
-    """Register a semantics class by import path (imported only when first used)."""
+    """Register a semantics class by import path.
+
+    The module is imported only when the semantics is first made, so naming a semantics costs
+    nothing until it is used (``cbst`` needs scikit-learn, ``particles`` pymunk).
+    """
     _REGISTRY[name] = (module, attribute)
 
 
@@ -71,8 +88,6 @@ def make_semantics(
 
     Raises ``ValueError`` naming the registered semantics when ``name`` is unknown.
     """
-    import importlib
-
     if name not in _REGISTRY:
         raise ValueError(f"unknown semantics {name!r}; expected one of {', '.join(_REGISTRY)}")
     module, attribute = _REGISTRY[name]

@@ -48,6 +48,7 @@ from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval,
 from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
+from arrange_up.cbst.model import load_model
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
@@ -67,7 +68,7 @@ class CBSTSemantics:
 
     ``particles`` is 2: the planner sees an interval belief as its two corner
     pseudo-particles. ``seed`` and ``workers`` are accepted for the registry's signature and
-    unused (predictions are deterministic and take microseconds). ``model`` names the
+    unused (predictions are deterministic and run in this process). ``model`` names the
     learned model (a shipped name or a card path).
     """
 
@@ -85,8 +86,6 @@ class CBSTSemantics:
         workers: int = 1,
         model: str = "default",
     ) -> None:
-        from arrange_up.cbst.model import load_model
-
         self.problem = problem
         self.particles = 2
         self.seed = seed

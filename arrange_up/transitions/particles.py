@@ -124,6 +124,7 @@ class ParticleSemantics:
     """PBST: ``particles`` world states, each simulated with its own noise (see module doc)."""
 
     name = "particles"
+    refuses_uncertain_contacts = False  # it predicts every push (see transitions.Semantics)
 
     def __init__(
         self, problem: ArrangementProblem, *, particles: int = 50, seed: int = 0, workers: int = 1

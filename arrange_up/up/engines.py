@@ -301,7 +301,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
             return result(
                 Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
             )
-        message = f"the planner stopped with status {outcome.status!r}"
+        message = f"the planner stopped with status {str(outcome.status)!r}"
         return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)
 
 

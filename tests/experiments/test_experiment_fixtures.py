@@ -7,8 +7,7 @@ import csv
 import pytest
 from click.testing import CliRunner
 
-import arrange_up.evaluation.evaluate
-import arrange_up.repair
+import arrange_up.experiments.fixtures as experiment
 from arrange_up.cli import main
 from arrange_up.experiments.fixtures import (
     FAILURE_KINDS,
@@ -36,9 +35,9 @@ def forbid(monkeypatch, *names):
         raise AssertionError("measured again although the CSV holds the row")
 
     if "repair" in names:
-        monkeypatch.setattr(arrange_up.repair, "repair_plan", refuse)
+        monkeypatch.setattr(experiment, "repair_plan", refuse)
     if "evaluate" in names:
-        monkeypatch.setattr(arrange_up.evaluation.evaluate, "evaluate_plan", refuse)
+        monkeypatch.setattr(experiment, "evaluate_plan", refuse)
 
 
 def test_rows_plots_and_resume(tmp_path, monkeypatch):
@@ -72,10 +71,7 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
 
     # A new particle count adds exactly its row, without redoing the nominal evaluation.
     calls = []
-    repair_plan, evaluate_plan = (
-        arrange_up.repair.repair_plan,
-        arrange_up.evaluation.evaluate.evaluate_plan,
-    )
+    repair_plan, evaluate_plan = experiment.repair_plan, experiment.evaluate_plan
 
     def counting_repair(*args, **kwargs):
         calls.append(("repair", kwargs["particles"]))
@@ -85,8 +81,8 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
         calls.append(("evaluate", len(actions)))
         return evaluate_plan(problem, actions, **kwargs)
 
-    monkeypatch.setattr(arrange_up.repair, "repair_plan", counting_repair)
-    monkeypatch.setattr(arrange_up.evaluation.evaluate, "evaluate_plan", counting_evaluate)
+    monkeypatch.setattr(experiment, "repair_plan", counting_repair)
+    monkeypatch.setattr(experiment, "evaluate_plan", counting_evaluate)
     fixture_experiment(tmp_path, problems=("down-push",), **{**TINY, "particles": (3, 4)})
     assert [what for what, _ in calls] == ["repair", "evaluate"] and calls[0][1] == 4
     assert rows(path)[:3] == first and rows(path)[3]["particles"] == "4"
@@ -94,7 +90,7 @@ def test_rows_plots_and_resume(tmp_path, monkeypatch):
 
 def test_a_problem_without_nominal_plan_is_recorded_not_skipped(tmp_path, monkeypatch):
     # As if the deterministic planner found no plan for down-push.
-    monkeypatch.setattr("arrange_up.repair.nominal_plans", lambda *_args, **_kwargs: [])
+    monkeypatch.setattr(experiment, "nominal_plans", lambda *_args, **_kwargs: [])
     path = fixture_experiment(tmp_path, problems=("down-push",), **{**TINY, "plans": 2})
     table = rows(path)
     assert [(r["plan"], r["stage"], r["status"]) for r in table] == [
@@ -127,7 +123,7 @@ def test_failed_and_raising_repairs_are_recorded_with_their_reason(tmp_path, mon
             return FailedRepair()
         raise ValueError("not a nominal plan of this problem")
 
-    monkeypatch.setattr(arrange_up.repair, "repair_plan", fake)
+    monkeypatch.setattr(experiment, "repair_plan", fake)
     path = fixture_experiment(tmp_path, problems=("down-push",), **TINY)
     _, failed, error = rows(path)
     assert (failed["status"], failed["reason"]) == ("failed", FailedRepair.reason)

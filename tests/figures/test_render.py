@@ -138,8 +138,15 @@ def test_off_table_note_and_tolerance(mixed: ArrangementProblem) -> None:
     assert goal_tolerance_half_widths(mixed)[2] == pytest.approx(math.pi)
 
 
-def test_importing_render_does_not_import_matplotlib() -> None:
-    code = "import sys, arrange_up.figures.render; print('matplotlib' in sys.modules)"
+def test_the_package_and_the_cli_help_do_not_import_matplotlib() -> None:
+    # The figure modules import matplotlib at module level; the package and the command line
+    # import them only where they draw, so neither `import arrange_up` nor `--help` pays for it.
+    code = (
+        "import sys, arrange_up, arrange_up.cli.commands as cli\n"
+        "from click.testing import CliRunner\n"
+        "assert CliRunner().invoke(cli.main, ['--help']).exit_code == 0\n"
+        "print('matplotlib' in sys.modules)"
+    )
     result = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )

@@ -12,7 +12,16 @@ from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.model.world import Place, Push, nominal_initial_state, nominal_noise
 from arrange_up.physics.simulation import simulate
-from arrange_up.planning.planner import NODE_LIMIT, SOLVED, TIMEOUT, plan
+from arrange_up.planning.planner import (
+    NODE_LIMIT,
+    SOLVED,
+    TIMEOUT,
+    PlanStatistics,
+    SearchSnapshot,
+    plan,
+)
+from arrange_up.planning.task import BeliefTask
+from arrange_up.search import SearchStatus
 from arrange_up.transitions import make_semantics
 from arrange_up.transitions.particles import ParticleSemantics
 
@@ -83,6 +92,59 @@ def test_node_limit_and_timeout_are_reported_honestly(blocks2):
     assert limited.stats["expanded"] == 1
     timed = plan(blocks2, semantics="deterministic", timeout=1e-9)
     assert timed.status == TIMEOUT and timed.actions is None
+
+
+def test_status_and_statistics_are_typed_and_serialise_as_before(blocks2):
+    snapshots = []
+    result = plan(blocks2, semantics="deterministic", progress=snapshots.append)
+    assert result.status is SearchStatus.SOLVED and result.status == "solved" == SOLVED
+    assert json.dumps(result.status) == '"solved"'
+    assert isinstance(result.statistics, PlanStatistics)
+    assert result.stats == result.statistics.to_json()
+    assert list(result.stats) == [
+        "expanded",
+        "generated",
+        "evaluated",
+        "pruned_dominated",
+        "pruned_infinite",
+        "pruned_duplicate",
+        "no_prediction",
+        "transitions_simulated",
+        "best_h",
+        "elapsed",
+        "max_nodes",
+        "heuristic",
+        "dominance",
+        "weight",
+    ]
+    assert result.stats["max_nodes"] == 5000 and result.stats["weight"] == 2.0
+    # Progress receives the search's part of the statistics, the last call its final counts.
+    field_names = [f for f in result.stats if f in SearchSnapshot.__dataclass_fields__]
+    assert snapshots and all(list(s) == field_names for s in snapshots)
+    assert snapshots[-1]["expanded"] == result.stats["expanded"]
+    assert result.statistics.best_h is None or result.statistics.best_h >= 0
+
+
+def test_the_task_answers_what_the_search_asks_and_closes_its_semantics(blocks2):
+    task = BeliefTask.build(
+        blocks2,
+        semantics="particles",
+        particles=3,
+        seed=0,
+        workers=1,
+        heuristic="inadmissible",
+        dominance=True,
+        variety=False,
+    )
+    try:
+        start = task.initial_belief()
+        assert not task.is_goal(start) and task.heuristic(start) > 0
+        edges = list(task.successors(start))
+        assert edges and all(edge.cost == 1.0 for edge in edges)
+        assert task.semantics.simulations == 0  # children are predicted only when asked for
+        assert task.dominance_index() is not task.dominance_index()  # one per search
+    finally:
+        task.close()
 
 
 def test_unknown_semantics_and_heuristic_are_refused(blocks2):
