@@ -142,7 +142,7 @@ def test_the_package_and_the_cli_help_do_not_import_matplotlib() -> None:
     # The figure modules import matplotlib at module level; the package and the command line
     # import them only where they draw, so neither `import arrange_up` nor `--help` pays for it.
     code = (
-        "import sys, arrange_up, arrange_up.cli.commands as cli\n"
+        "import sys, arrange_up, arrange_up.cli as cli\n"
         "from click.testing import CliRunner\n"
         "assert CliRunner().invoke(cli.main, ['--help']).exit_code == 0\n"
         "print('matplotlib' in sys.modules)"

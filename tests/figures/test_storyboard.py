@@ -12,7 +12,7 @@ from catalogue import tiny
 
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.evaluation.evaluate import trace_rollout
-from arrange_up.figures import render
+from arrange_up.figures.backend import pyplot
 from arrange_up.figures.storyboard import _describe, draw_storyboard, storyboard_data
 from arrange_up.model.world import Pick, Place, Push
 
@@ -96,7 +96,7 @@ def test_draw_storyboard_writes_a_png_of_one_panel_per_action(tmp_path):
 
 
 def test_draw_storyboard_of_a_fixture_plan_with_particles_closes_its_figure(tmp_path):
-    plt = render._plt()  # pyplot on the Agg backend, as the storyboard uses it
+    plt = pyplot()  # pyplot on the Agg backend, as the storyboard uses it
     problem = tiny("block-and-fixture")
     plan = (Pick("bar"), Place("A", (5.088, 0.912, 0.0)))
     before = set(plt.get_fignums())
