@@ -67,7 +67,8 @@ def main() -> int:
     parser.add_argument("--no-dask", action="store_true")
     args = parser.parse_args()
 
-    from arrange_up.evaluation.evaluate import _Context, _rollout_task, evaluate_plan, plan_hash
+    from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
+    from arrange_up.evaluation.rollouts import RolloutContext, rollout_task
     from arrange_up.io.domains import load
     from arrange_up.io.planfile import read_plan
     from arrange_up.model.problem import problem_hash
@@ -117,10 +118,10 @@ def main() -> int:
         # the same rollouts through joblib's Dask backend, for comparison
         from joblib import Parallel, delayed, parallel_config
 
-        context = _Context(
+        context = RolloutContext(
             f"{problem_hash(problem)} {plan_hash(actions)}", problem, tuple(actions), args.seed
         )
-        fn = partial(_rollout_task, context)
+        fn = partial(rollout_task, context)
         size = auto_chunksize(n, runner.workers)
         t0 = time.perf_counter()
         with parallel_config(backend="dask"):

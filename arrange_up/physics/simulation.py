@@ -4,10 +4,10 @@ This is the only module of arrange-up that imports pymunk. Its face is one funct
 
     simulate(problem, state, action, noise=None, settings=DEFAULT_SETTINGS) -> StepOutcome
 
-plus :func:`rollout`, which draws the noise of each action of a sequence and simulates them in
-turn. Everything is in inches, seconds and radians; a body's mass is its areal density times its
-area (so a 1-inch block of density 0.125 has mass 0.125) and forces are in mass-inches per
-second squared.
+(a sequence of actions under drawn noise is run by :mod:`arrange_up.evaluation.rollouts`, which
+also judges failures). Everything is in inches, seconds and radians; a body's mass is its areal
+density times its area (so a 1-inch block of density 0.125 has mass 0.125) and forces are in
+mass-inches per second squared.
 
 Actions
 =======
@@ -50,11 +50,10 @@ Model
   zero. The robot still holds the paddle, though, so it becomes a *brake* (the same joint with
   ``max_bias = 0``: it resists being moved, up to the force clip, and pulls nowhere) until the
   other bodies are at rest; then the paddle is removed. The thesis's literal alternative, a
-  paddle left free, was measured and rejected: released from a chain compressed against a wall,
-  the light frictionless paddle is kicked back by the contact solver's warm-started impulses,
-  so the blocks spring apart (gaps up to 0.025 in, chains moved up to 0.08 in, 15% more steps
-  on the benchmark chains), an artefact; with the brake, blocks end touching (overlaps within
-  the 0.005 in slop).
+  paddle left free, is rejected: released from a chain compressed against a wall, the light
+  frictionless paddle is kicked back by the contact solver's warm-started impulses, so the
+  blocks spring apart, an artefact; with the brake, blocks end touching (overlaps within the
+  slop). Figures: ``docs/design/physics.md``.
 
 The push controller
 ===================
@@ -74,8 +73,8 @@ Here it runs on pymunk's C side as one ``PivotJoint`` between the static body (a
 
 Each step the joint applies the impulse that brings the paddle's velocity to
 ``clamp(rate (ref - x), push_speed)``, clamped to ``push_force * dt``. For the paddle alone that
-is, exactly (same floating-point recurrence, see ``tests/test_physics.py``), the semi-implicit
-Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))`` with
+is, exactly (same floating-point recurrence, see ``tests/physics/test_physics.py``), the
+semi-implicit Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))`` with
 
     Kd = m / dt,   Kp = rate * Kd = m / (4 damping_ratio**2 dt**2),
 
@@ -93,9 +92,8 @@ speed while pushing and stalls only when the push needs more than ``push_force``
 wall), whereas a PD with the paddle's own gains would stall once ``Kp * error`` falls below the
 resistance. The thesis's observation that a push stops short when it collides holds in both.
 
-Defaults: ``push_speed = 3 in/s`` (a careful robot push; 1 to 5-inch pushes take 0.7 to 2.2 s
-of simulated time including the rest checks, and the paddle travels 0.0125 in per step, far
-below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
+Defaults: ``push_speed = 3 in/s`` (a careful robot push; the paddle travels 0.0125 in per step,
+far below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
 above; a 1-inch block of density 0.125 weighs 48, so this pushes a chain of 7 blocks at the
 highest friction and density of the thesis's ranges, 223, with margin, and still stalls against
 a wall instead of crushing through it). Densities are in each problem's own units, so a problem
@@ -119,27 +117,24 @@ as ``NOT_AT_REST`` with the poses at the cap, never silently truncated.
 
 Overlaps beyond the slop are pushed apart at 20% per step (``collision_bias``, Box2D's
 Baumgarte factor) rather than pymunk's default 2.6%: a chain that hits a wall at 3 in/s is
-squeezed by the solver, and at the default rate its slow re-expansion against the paddle kept
-the paddle creeping for most of a second (a 7-block chain took 458 steps instead of 266, with
-final poses within 0.004 in of each other).
+squeezed by the solver, and at the default rate its slow re-expansion against the paddle keeps
+the paddle creeping for most of a second.
 
-Accuracy: on the benchmark scenes (:mod:`arrange_up.physics.bench`, 30 noisy pushes each) final
-positions at the defaults were within 0.01-0.02 in (median) and 0.033 in (max) of a run at
-dt 1/960 with 30 iterations.
+The defaults' accuracy (against a finer step) and every other figure behind them are in
+``docs/design/physics.md``, with the commands that reproduce them.
 
 Determinism and speed
 =====================
 A fresh space is built per push, in a fixed order (walls, obstacles, movable bodies in state
 order, the manipulator), with explicit masses, so the same inputs give bit-identical results in
-any process (a reused space does not; see ``shared/notes/physics.md``).
+any process (a reused space does not).
 
 Speed is first-class: pushes are simulated millions of times by the planners. The space is
 built and stepped through pymunk's cffi binding (``pymunk._chipmunk_cffi.lib``, the C functions
 the pymunk classes wrap) rather than through the Python classes, whose per-object bookkeeping
-cost more than the simulation itself for small scenes (building a 1-block scene takes ~30 us
-this way against ~300 us through the classes); the controller runs entirely in C, so a step is
-one C call (~0.5 us of it is the call and the step's fixed cost); Python looks at the bodies
-only every ``rest_interval``. Everything built is freed explicitly (``try``/``finally``).
+costs more than the simulation itself for small scenes; the controller runs entirely in C, so a
+step is one C call; Python looks at the bodies only every ``rest_interval`` (timings:
+``docs/design/physics.md``). Everything built is freed explicitly (``try``/``finally``).
 ``pymunk._chipmunk_cffi`` is not public API (``pymunk.batch`` uses it too); pyproject pins
 pymunk ~= 7.3 and the tests exercise every call made here.
 """
@@ -151,11 +146,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 # pymunk's cffi binding: the Chipmunk2D C API that pymunk's classes wrap (pymunk ~= 7.3).
 from pymunk._chipmunk_cffi import ffi, lib
 
+from arrange_up.geometry.boxes import WALL_NAMES, box_corners, wall_boxes
+from arrange_up.geometry.se2 import rotate, transform_point
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, Pose, Table
 from arrange_up.model.world import (
     Action,
@@ -164,7 +159,6 @@ from arrange_up.model.world import (
     Place,
     Push,
     WorldState,
-    draw_noise,
     nominal_noise,
 )
 
@@ -174,7 +168,6 @@ __all__ = [
     "StepOutcome",
     "StepStatus",
     "pd_gains",
-    "rollout",
     "simulate",
 ]
 
@@ -188,15 +181,14 @@ __all__ = [
 class PhysicsSettings:
     """Numerical and controller settings of the simulation (inches, seconds, radians).
 
-    Every default is measured or argued in ``shared/notes/physics.md`` or in this module's
-    docstring.
+    Every default is argued in this module's docstring or measured in
+    ``docs/design/physics.md``.
     """
 
     dt: float = 1.0 / 240.0
-    """Time step. 1/60 is too coarse for chains of blocks (0.3 in errors, buckling, 6% never
-    settle); 1/240 gave 0.02-0.06 in against a 1/960 reference and always settled."""
+    """Time step. 1/60 is too coarse for chains of blocks (see ``docs/design/physics.md``)."""
     iterations: int = 10
-    """Solver iterations per step; 5-10 were accurate at dt 1/240, 10 is the safe end."""
+    """Solver iterations per step (10: the safe end of the accurate range at dt 1/240)."""
     collision_slop: float = 0.005
     """Allowed resting overlap (in). pymunk's default 0.1 is sized for pixels."""
     collision_bias: float = 0.8**240
@@ -440,22 +432,6 @@ _CACHE: dict[int, _Compiled] = {}
 _CACHE_SIZE = 16
 
 
-def _wall_boxes(table: Table, thickness: float) -> list[tuple[tuple[float, float], ...]]:
-    w, d, t = table.width, table.depth, thickness
-    boxes = {
-        "left": (-t, -t, 0.0, d + t),
-        "right": (w, -t, w + t, d + t),
-        "bottom": (-t, -t, w + t, 0.0),
-        "top": (-t, d, w + t, d + t),
-    }
-    out = []
-    for edge in ("left", "right", "bottom", "top"):  # fixed order, whatever the file's order
-        if edge in table.walls:
-            x0, y0, x1, y1 = boxes[edge]
-            out.append(((x0, y0), (x1, y0), (x1, y1), (x0, y1)))
-    return out
-
-
 def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
     key = id(problem)
     hit = _CACHE.get(key)
@@ -463,17 +439,17 @@ def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
         return hit
     bodies: dict[str, _Body] = {}
     statics: list[tuple[int, object]] = []
-    for poly in _wall_boxes(problem.table, wall_thickness):
-        statics.append((len(poly), ffi.new("cpVect[]", poly)))
+    # Walls in a fixed order, whatever the file's order: the space is built in that order.
+    edges = [edge for edge in WALL_NAMES if edge in problem.table.walls]
+    for box in wall_boxes(problem.table.size, edges, wall_thickness).values():
+        statics.append((4, ffi.new("cpVect[]", box_corners(box))))
     for spec in problem.objects:
         parts = spec.shape.parts
         if spec.kind is ObjectKind.OBSTACLE:
             if spec.pose is None:
                 raise ValueError(f"obstacle {spec.name!r} has no pose")
-            x, y, th = spec.pose
-            c, s = math.cos(th), math.sin(th)
             for part in parts:
-                world = [(x + c * px - s * py, y + s * px + c * py) for px, py in part]
+                world = [transform_point(point, spec.pose) for point in part]
                 statics.append((len(world), ffi.new("cpVect[]", world)))
             continue
         areas = [_poly_area(part) for part in parts]
@@ -527,29 +503,6 @@ def simulate(
     if isinstance(action, Pick):
         return _pick(compiled, state, action)
     raise ValueError(f"unknown action {action!r}: expected Place, Push or Pick")
-
-
-def rollout(
-    problem: ArrangementProblem,
-    state: WorldState,
-    actions: Sequence[Action],
-    rng: np.random.Generator,
-    settings: PhysicsSettings = DEFAULT_SETTINGS,
-) -> list[StepOutcome]:
-    """Simulate ``actions`` in turn from ``state``, drawing each one's noise from ``rng``.
-
-    Noise is drawn with :func:`arrange_up.model.world.draw_noise` (always the same amount of
-    randomness per action). Stops after the first outcome that is not ``OK``, which is the last
-    one returned.
-    """
-    outcomes: list[StepOutcome] = []
-    for action in actions:
-        outcome = simulate(problem, state, action, draw_noise(problem, action, rng), settings)
-        outcomes.append(outcome)
-        if not outcome.ok:
-            break
-        state = outcome.state
-    return outcomes
 
 
 def _check_state(compiled: _Compiled, state: WorldState) -> None:
@@ -736,9 +689,7 @@ def _push(
         px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
         paddle = lib.cpBodyNew(noise.manipulator_density * paddle_def.area, math.inf)
         add_body(paddle, paddle_def, px, py, pth)
-        ux, uy = paddle_def.push_direction
-        c, sn = math.cos(pth), math.sin(pth)
-        dx, dy = ux * c - uy * sn, ux * sn + uy * c
+        dx, dy = rotate(paddle_def.push_direction, pth)
 
         # 4. settle, then look for overlaps in the contacts the engine built
         for _ in range(s.settle_steps):
