@@ -1,4 +1,5 @@
-"""Tests of arrange_up.physics.simulation: place, pick and push on small problems built in code."""
+"""Tests of arrange_up.physics (simulation, bodies, settings): place, pick and push on small
+problems built in code."""
 
 from __future__ import annotations
 
@@ -21,11 +22,11 @@ from arrange_up.model.problem import (
     Uncertainty,
 )
 from arrange_up.model.world import ActionNoise, Pick, Place, Push, WorldState
+from arrange_up.physics.bodies import _abs_r_integral
 from arrange_up.physics.simulation import (
     DEFAULT_SETTINGS,
     PhysicsSettings,
     StepStatus,
-    _abs_r_integral,
     _drive_trajectory,
     pd_gains,
     push_force,
