@@ -49,7 +49,7 @@ from arrange_up.evaluation.outcomes import (
 from arrange_up.geometry.collision import PenetrationDepths
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Place, WorldState, draw_noise
-from arrange_up.physics import simulation
+from arrange_up.physics import simulation  # simulate looked up per call: tests replace it
 from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus
 
 __all__ = [
