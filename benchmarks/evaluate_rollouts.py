@@ -28,12 +28,18 @@ from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
+from joblib import Parallel, delayed, parallel_config
+
+from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
+from arrange_up.evaluation.rollouts import RolloutContext, rollout_task
+from arrange_up.io.domains import load
+from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
+from arrange_up.model.problem import problem_hash
+from arrange_up.parallel import _apply_chunk, _chunks, auto_chunksize, get_runner
+from arrange_up.planning.planner import plan
+
 
 def _plan(problem_name: str, max_nodes: int | None) -> Path:
-    from arrange_up.io.domains import load
-    from arrange_up.io.planfile import plan_document, write_json_atomic
-    from arrange_up.planning.planner import plan
-
     problem = load(problem_name)
     t0 = time.perf_counter()
     result = plan(problem, semantics="deterministic", seed=0, max_nodes=max_nodes)
@@ -66,12 +72,6 @@ def main() -> int:
     parser.add_argument("--max-nodes", type=int, default=None)
     parser.add_argument("--no-dask", action="store_true")
     args = parser.parse_args()
-
-    from arrange_up.evaluation.evaluate import _Context, _rollout_task, evaluate_plan, plan_hash
-    from arrange_up.io.domains import load
-    from arrange_up.io.planfile import read_plan
-    from arrange_up.model.problem import problem_hash
-    from arrange_up.parallel import _apply_chunk, _chunks, auto_chunksize, get_runner
 
     problem = load(args.problem)
     plan_path = Path(args.plan) if args.plan else _plan(args.problem, args.max_nodes)
@@ -115,12 +115,10 @@ def main() -> int:
         dask_rows.append(td)
 
         # the same rollouts through joblib's Dask backend, for comparison
-        from joblib import Parallel, delayed, parallel_config
-
-        context = _Context(
+        context = RolloutContext(
             f"{problem_hash(problem)} {plan_hash(actions)}", problem, tuple(actions), args.seed
         )
-        fn = partial(_rollout_task, context)
+        fn = partial(rollout_task, context)
         size = auto_chunksize(n, runner.workers)
         t0 = time.perf_counter()
         with parallel_config(backend="dask"):

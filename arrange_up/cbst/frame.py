@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from arrange_up.geometry.se2 import rotate_cs
 from arrange_up.geometry.shapes import Box, HalfWidths, Pose
 
 __all__ = ["CanonicalFrame", "DIRECTION_NAMES"]
@@ -89,11 +90,13 @@ class CanonicalFrame:
     # -- points and poses ------------------------------------------------------------------
     def point_to(self, x: float, y: float) -> tuple[float, float]:
         c, s = self.vector
-        return (c * x + s * y + 0.0, -s * x + c * y + 0.0)
+        u, v = rotate_cs((x, y), c, -s)  # by -alpha
+        return (u + 0.0, v + 0.0)  # + 0.0: no negative zeros
 
     def point_from(self, u: float, v: float) -> tuple[float, float]:
         c, s = self.vector
-        return (c * u - s * v + 0.0, s * u + c * v + 0.0)
+        x, y = rotate_cs((u, v), c, s)  # by +alpha
+        return (x + 0.0, y + 0.0)
 
     def pose_to(self, pose: Pose) -> Pose:
         u, v = self.point_to(pose[0], pose[1])

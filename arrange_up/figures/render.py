@@ -38,6 +38,7 @@ from shapely.geometry import Polygon
 
 from arrange_up.figures.backend import pyplot
 from arrange_up.geometry import shapes as geometry
+from arrange_up.geometry.se2 import compose, rotate
 from arrange_up.io.domains import first_sentence
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, ObjectSpec, Pose
 
@@ -108,14 +109,6 @@ def goal_tolerance_half_widths(problem: ArrangementProblem) -> HalfWidths:
     """The goal tolerance as pose half-widths; an any-angle tolerance becomes a full turn."""
     dx, dy, dtheta = problem.goal.tolerance
     return (dx, dy, math.pi if dtheta is None else dtheta)
-
-
-def _compose(reference: Pose, relative: Pose) -> Pose:
-    """The world pose of ``relative`` (a pose in the frame of ``reference``)."""
-    xr, yr, tr = reference
-    x, y, t = relative
-    c, s = math.cos(tr), math.sin(tr)
-    return (xr + c * x - s * y, yr + s * x + c * y, tr + t)
 
 
 def _rings(geom: Any) -> list[Any]:
@@ -432,7 +425,7 @@ def draw_relative_goal(
     )
     for name, relative in goal.targets:
         artists += _draw_target(
-            ax, problem, name, _compose(reference_pose, relative), tolerance=tolerance
+            ax, problem, name, compose(reference_pose, relative), tolerance=tolerance
         )
     if title:
         ax.set_title(f"relative goal (reference: {goal.reference})", fontsize=10)
@@ -733,9 +726,7 @@ def draw_heatmap(
     best = scores.best
     approach = best.push if best is not None and best.push is not None else push
     artists += draw_object(ax, paddle, approach.pose, color=MANIPULATOR_COLOR, zorder=4)
-    px, py = paddle.push_direction
-    c, s = math.cos(approach.pose[2]), math.sin(approach.pose[2])
-    ux, uy = c * px - s * py, s * px + c * py
+    ux, uy = rotate(paddle.push_direction, approach.pose[2])
     length = push.distance + scores.backoff
     artists.append(
         ax.annotate(

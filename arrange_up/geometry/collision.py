@@ -1,5 +1,5 @@
 """Collision tests on a problem's table: exact footprints for world states, belief shadows for
-action preconditions (thesis §2.1.3).
+action preconditions (thesis §2.1.3), and penetration depths of a placed object.
 
 Shadow tests are the hot path of action generation, so they run in two stages: axis-aligned
 shadow boxes first (numpy, microseconds), and only when two boxes overlap, the exact convex
@@ -10,10 +10,17 @@ against, whatever the pose within the intervals.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from functools import lru_cache
 
+import numpy as np
+from shapely.geometry import box as shapely_box
+
 from arrange_up.geometry import shapes as geometry
+from arrange_up.geometry.boxes import box_corners, wall_boxes
+from arrange_up.geometry.polygons import convex_penetration
+from arrange_up.geometry.se2 import transform_points
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, Pose
 from arrange_up.model.world import WorldState
 
@@ -113,6 +120,59 @@ class CollisionChecker:
 
 
 def _box_geom(box):
-    from shapely.geometry import box as shapely_box
-
     return shapely_box(*box)
+
+
+class PenetrationDepths:
+    """How deeply an object overlaps the others, the walls and the obstacles of one problem's
+    table: the deepest :func:`~arrange_up.geometry.polygons.convex_penetration` over pairs of
+    convex parts (exact shapes at exact poses, no shadows)."""
+
+    def __init__(self, problem: ArrangementProblem) -> None:
+        self.parts = {
+            spec.name: [np.asarray(part, dtype=float) for part in spec.shape.parts]
+            for spec in problem.objects
+        }
+        self.radius = {spec.name: spec.shape.radius for spec in problem.objects}
+        fixed: list[tuple[str, np.ndarray]] = []
+        for edge, box in wall_boxes(problem.table.size, problem.table.walls).items():
+            fixed.append((f"the {edge} wall", np.array(box_corners(box))))
+        for spec in problem.obstacles:
+            if spec.pose is not None:
+                for part in self.parts[spec.name]:
+                    fixed.append((spec.name, transform_points(part, spec.pose)))
+        self.fixed = fixed
+        """``(label, world polygon)`` of every wall (``"the left wall"``) and obstacle part."""
+
+    def deepest(self, state: WorldState, name: str) -> tuple[str, float]:
+        """The deepest overlap of ``name`` (on the table in ``state``) with any other object of
+        ``state``, wall or obstacle: ``(what, depth)``, ``("nothing", 0.0)`` when none. The
+        first found wins a tie (objects in state order, then walls, then obstacles)."""
+        pose = state.pose(name)
+        assert pose is not None
+        placed = [transform_points(part, pose) for part in self.parts[name]]
+        reach = self.radius[name]
+        worst = ("nothing", 0.0)
+        for other, other_pose in state.poses:
+            if (
+                other == name
+                or math.hypot(other_pose[0] - pose[0], other_pose[1] - pose[1])
+                > reach + self.radius[other]
+            ):
+                continue
+            for part in self.parts[other]:
+                world = transform_points(part, other_pose)
+                for mine in placed:
+                    depth = convex_penetration(mine, world)
+                    if depth > worst[1]:
+                        worst = (other, depth)
+        lo = np.array([pose[0] - reach, pose[1] - reach])
+        hi = np.array([pose[0] + reach, pose[1] + reach])
+        for label, poly in self.fixed:
+            if np.any(poly.max(axis=0) < lo) or np.any(poly.min(axis=0) > hi):
+                continue
+            for mine in placed:
+                depth = convex_penetration(mine, poly)
+                if depth > worst[1]:
+                    worst = (label, depth)
+        return worst

@@ -23,9 +23,14 @@ reported separately as ``startup_seconds``.
 
 from __future__ import annotations
 
+import argparse
 import math
+import os
+import sys
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import replace
+from fractions import Fraction
 
 import numpy as np
 
@@ -39,7 +44,8 @@ from arrange_up.model.problem import (
     Uncertainty,
 )
 from arrange_up.model.world import ActionNoise, Push, WorldState, draw_noise
-from arrange_up.physics.simulation import StepStatus, simulate
+from arrange_up.parallel import local_executor
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus, simulate
 
 SCENES: tuple[str, ...] = ("1 block", "3-block chain", "7-block chain")
 
@@ -123,8 +129,6 @@ def _run_chunk(
 
 
 def _warm(problem: ArrangementProblem, push: Push, tasks, pause: float) -> int:
-    import os
-
     _run_chunk(problem, push, tasks)
     time.sleep(pause)  # hold this worker so the next warm-up task goes to another one
     return os.getpid()
@@ -163,8 +167,6 @@ def bench_physics(
         if count > 1:
             # The project's shared process pool (arrange_up.parallel): planning and evaluation
             # use the same one, and mixing it with a separate joblib.Parallel pool breaks loky.
-            from arrange_up.parallel import local_executor
-
             if progress:
                 progress(f"starting a pool of {count} worker processes")
             t0 = time.perf_counter()
@@ -209,6 +211,61 @@ def bench_physics(
     return rows
 
 
+def compare_settings(
+    settings: PhysicsSettings,
+    reference: PhysicsSettings,
+    n_pushes: int = 30,
+    seed: int = 0,
+) -> list[dict]:
+    """How far the final poses under ``settings`` are from those under ``reference``, on the
+    same noisy pushes of each scene (the tasks :func:`bench_physics` draws).
+
+    One row per scene: ``scene``, ``pushes``, ``median`` and ``max`` distance (in) between a
+    block's final centre in the two runs (over every block of every push), ``steps`` and
+    ``reference_steps`` (mean physics steps per push), ``not_ok`` and ``reference_not_ok``
+    (pushes whose outcome is not ``OK``).
+    """
+    rng = np.random.default_rng(seed)
+    rows = []
+    for name in SCENES:
+        problem, state, push = scene(name)
+        distances: list[float] = []
+        steps = [0, 0]
+        not_ok = [0, 0]
+        for start, noise in _tasks(problem, state, push, n_pushes, rng):
+            runs = [simulate(problem, start, push, noise, s) for s in (settings, reference)]
+            for k, outcome in enumerate(runs):
+                steps[k] += outcome.steps
+                not_ok[k] += not outcome.ok
+            for (_, a), (_, b) in zip(runs[0].state.poses, runs[1].state.poses, strict=True):
+                distances.append(math.hypot(a[0] - b[0], a[1] - b[1]))
+        rows.append(
+            {
+                "scene": name,
+                "pushes": n_pushes,
+                "median": float(np.median(distances)),
+                "max": max(distances),
+                "steps": steps[0] / n_pushes,
+                "reference_steps": steps[1] / n_pushes,
+                "not_ok": not_ok[0],
+                "reference_not_ok": not_ok[1],
+            }
+        )
+    return rows
+
+
+def _settings_of(assignments: Sequence[str]) -> PhysicsSettings:
+    """``PhysicsSettings`` with ``KEY=VALUE`` overrides (values as fractions: ``dt=1/960``)."""
+    changes: dict[str, float | int] = {}
+    for item in assignments:
+        key, _, value = item.partition("=")
+        number = Fraction(value)
+        changes[key] = (
+            int(number) if number.denominator == 1 and "." not in value else float(number)
+        )
+    return replace(DEFAULT_SETTINGS, **changes)
+
+
 def format_rows(rows: Sequence[dict]) -> str:
     """The rows as a plain-text table."""
     lines = [
@@ -226,14 +283,27 @@ def format_rows(rows: Sequence[dict]) -> str:
 
 
 if __name__ == "__main__":  # pragma: no cover - quick manual runs
-    import argparse
-    import sys
-
     parser = argparse.ArgumentParser(description="push rollouts per second")
     parser.add_argument("--pushes", type=int, default=200)
     parser.add_argument("--workers", default="1,2")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--compare",
+        nargs="*",
+        metavar="KEY=VALUE",
+        help="instead of timing: final poses under these settings against --reference's",
+    )
+    parser.add_argument("--reference", nargs="*", metavar="KEY=VALUE", default=[])
     args = parser.parse_args()
+    if args.compare is not None:
+        tested, reference = _settings_of(args.compare), _settings_of(args.reference)
+        for row in compare_settings(tested, reference, args.pushes, args.seed):
+            print(
+                f"{row['scene']:<16} median {row['median']:.4f} in, max {row['max']:.4f} in; "
+                f"steps {row['steps']:.0f} vs {row['reference_steps']:.0f}; "
+                f"not ok {row['not_ok']} vs {row['reference_not_ok']}"
+            )
+        sys.exit(0)
     result = bench_physics(
         n_pushes=args.pushes,
         workers=tuple(int(w) for w in args.workers.split(",")),

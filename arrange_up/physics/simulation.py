@@ -1,13 +1,15 @@
 """Top-down rigid-body physics of place, push and pick (thesis §2.1.3, §2.4.1), on pymunk.
 
-This is the only module of arrange-up that imports pymunk. Its face is one function::
+Only the physics room imports pymunk: this module (the space, the controller, rest) and
+:mod:`~arrange_up.physics.bodies` (the shapes compiled once per problem); the settings are in
+:mod:`~arrange_up.physics.settings`. The room's face is one function::
 
     simulate(problem, state, action, noise=None, settings=DEFAULT_SETTINGS) -> StepOutcome
 
-plus :func:`rollout`, which draws the noise of each action of a sequence and simulates them in
-turn. Everything is in inches, seconds and radians; a body's mass is its areal density times its
-area (so a 1-inch block of density 0.125 has mass 0.125) and forces are in mass-inches per
-second squared.
+(a sequence of actions under drawn noise is run by :mod:`arrange_up.evaluation.rollouts`, which
+also judges failures). Everything is in inches, seconds and radians; a body's mass is its areal
+density times its area (so a 1-inch block of density 0.125 has mass 0.125) and forces are in
+mass-inches per second squared.
 
 Actions
 =======
@@ -50,11 +52,10 @@ Model
   zero. The robot still holds the paddle, though, so it becomes a *brake* (the same joint with
   ``max_bias = 0``: it resists being moved, up to the force clip, and pulls nowhere) until the
   other bodies are at rest; then the paddle is removed. The thesis's literal alternative, a
-  paddle left free, was measured and rejected: released from a chain compressed against a wall,
-  the light frictionless paddle is kicked back by the contact solver's warm-started impulses,
-  so the blocks spring apart (gaps up to 0.025 in, chains moved up to 0.08 in, 15% more steps
-  on the benchmark chains), an artefact; with the brake, blocks end touching (overlaps within
-  the 0.005 in slop).
+  paddle left free, is rejected: released from a chain compressed against a wall, the light
+  frictionless paddle is kicked back by the contact solver's warm-started impulses, so the
+  blocks spring apart, an artefact; with the brake, blocks end touching (overlaps within the
+  slop). Figures: ``docs/design/physics.md``.
 
 The push controller
 ===================
@@ -74,8 +75,8 @@ Here it runs on pymunk's C side as one ``PivotJoint`` between the static body (a
 
 Each step the joint applies the impulse that brings the paddle's velocity to
 ``clamp(rate (ref - x), push_speed)``, clamped to ``push_force * dt``. For the paddle alone that
-is, exactly (same floating-point recurrence, see ``tests/test_physics.py``), the semi-implicit
-Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))`` with
+is, exactly (same floating-point recurrence, see ``tests/physics/test_physics.py``), the
+semi-implicit Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))`` with
 
     Kd = m / dt,   Kp = rate * Kd = m / (4 damping_ratio**2 dt**2),
 
@@ -93,9 +94,8 @@ speed while pushing and stalls only when the push needs more than ``push_force``
 wall), whereas a PD with the paddle's own gains would stall once ``Kp * error`` falls below the
 resistance. The thesis's observation that a push stops short when it collides holds in both.
 
-Defaults: ``push_speed = 3 in/s`` (a careful robot push; 1 to 5-inch pushes take 0.7 to 2.2 s
-of simulated time including the rest checks, and the paddle travels 0.0125 in per step, far
-below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
+Defaults: ``push_speed = 3 in/s`` (a careful robot push; the paddle travels 0.0125 in per step,
+far below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
 above; a 1-inch block of density 0.125 weighs 48, so this pushes a chain of 7 blocks at the
 highest friction and density of the thesis's ranges, 223, with margin, and still stalls against
 a wall instead of crushing through it). Densities are in each problem's own units, so a problem
@@ -119,27 +119,24 @@ as ``NOT_AT_REST`` with the poses at the cap, never silently truncated.
 
 Overlaps beyond the slop are pushed apart at 20% per step (``collision_bias``, Box2D's
 Baumgarte factor) rather than pymunk's default 2.6%: a chain that hits a wall at 3 in/s is
-squeezed by the solver, and at the default rate its slow re-expansion against the paddle kept
-the paddle creeping for most of a second (a 7-block chain took 458 steps instead of 266, with
-final poses within 0.004 in of each other).
+squeezed by the solver, and at the default rate its slow re-expansion against the paddle keeps
+the paddle creeping for most of a second.
 
-Accuracy: on the benchmark scenes (:mod:`arrange_up.physics.bench`, 30 noisy pushes each) final
-positions at the defaults were within 0.01-0.02 in (median) and 0.033 in (max) of a run at
-dt 1/960 with 30 iterations.
+The defaults' accuracy (against a finer step) and every other figure behind them are in
+``docs/design/physics.md``, with the commands that reproduce them.
 
 Determinism and speed
 =====================
 A fresh space is built per push, in a fixed order (walls, obstacles, movable bodies in state
 order, the manipulator), with explicit masses, so the same inputs give bit-identical results in
-any process (a reused space does not; see ``shared/notes/physics.md``).
+any process (a reused space does not).
 
 Speed is first-class: pushes are simulated millions of times by the planners. The space is
 built and stepped through pymunk's cffi binding (``pymunk._chipmunk_cffi.lib``, the C functions
 the pymunk classes wrap) rather than through the Python classes, whose per-object bookkeeping
-cost more than the simulation itself for small scenes (building a 1-block scene takes ~30 us
-this way against ~300 us through the classes); the controller runs entirely in C, so a step is
-one C call (~0.5 us of it is the call and the step's fixed cost); Python looks at the bodies
-only every ``rest_interval``. Everything built is freed explicitly (``try``/``finally``).
+costs more than the simulation itself for small scenes; the controller runs entirely in C, so a
+step is one C call; Python looks at the bodies only every ``rest_interval`` (timings:
+``docs/design/physics.md``). Everything built is freed explicitly (``try``/``finally``).
 ``pymunk._chipmunk_cffi`` is not public API (``pymunk.batch`` uses it too); pyproject pins
 pymunk ~= 7.3 and the tests exercise every call made here.
 """
@@ -151,11 +148,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 # pymunk's cffi binding: the Chipmunk2D C API that pymunk's classes wrap (pymunk ~= 7.3).
 from pymunk._chipmunk_cffi import ffi, lib
 
+from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, Pose, Table
 from arrange_up.model.world import (
     Action,
@@ -164,8 +160,15 @@ from arrange_up.model.world import (
     Place,
     Push,
     WorldState,
-    draw_noise,
     nominal_noise,
+)
+from arrange_up.physics.bodies import _IDENTITY, _compile, _Compiled
+from arrange_up.physics.settings import (
+    DEFAULT_SETTINGS,
+    PhysicsSettings,
+    _force_clip,
+    pd_gains,
+    push_force,
 )
 
 __all__ = [
@@ -174,159 +177,14 @@ __all__ = [
     "StepOutcome",
     "StepStatus",
     "pd_gains",
-    "rollout",
+    "push_force",
     "simulate",
 ]
 
 
 # ----------------------------------------------------------------------------------------------
-# Settings and outcome
+# Outcome
 # ----------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class PhysicsSettings:
-    """Numerical and controller settings of the simulation (inches, seconds, radians).
-
-    Every default is measured or argued in ``shared/notes/physics.md`` or in this module's
-    docstring.
-    """
-
-    dt: float = 1.0 / 240.0
-    """Time step. 1/60 is too coarse for chains of blocks (0.3 in errors, buckling, 6% never
-    settle); 1/240 gave 0.02-0.06 in against a 1/960 reference and always settled."""
-    iterations: int = 10
-    """Solver iterations per step; 5-10 were accurate at dt 1/240, 10 is the safe end."""
-    collision_slop: float = 0.005
-    """Allowed resting overlap (in). pymunk's default 0.1 is sized for pixels."""
-    collision_bias: float = 0.8**240
-    """Fraction of an overlap beyond the slop left uncorrected after one second: ``0.8 ** 240``
-    corrects 20% per step at dt 1/240 (Box2D's Baumgarte factor; pymunk's default ``0.9 ** 60``
-    is 2.6% per step and lets squeezed chains creep for a second, see the module docstring)."""
-    gravity: float = 386.09
-    """Standard gravity in in/s^2; only the table friction uses it (the world is top-down)."""
-    rest_interval: float = 0.1
-    """Simulated time between rest checks (s); rounded to whole steps (24 at dt 1/240)."""
-    rest_linear_tol: float = 1e-3
-    """A body is still when it moved less than this (in) since the previous check..."""
-    rest_angular_tol: float = 1e-3
-    """...and turned less than this (rad)."""
-    rest_checks: int = 2
-    """Consecutive still checks that make rest (one can be a momentary stop)."""
-    max_time: float = 20.0
-    """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
-    settle_steps: int = 2
-    """Steps run after writing the state, before driving the manipulator: the thesis ran "a
-    couple of time steps" so the engine builds its contact state first. The overlap check reads
-    the contacts they build (0 turns the check off)."""
-    push_speed: float = 3.0
-    """Speed limit of the manipulator (in/s): a careful robot push, 0.0125 in per step."""
-    push_force: float = 400.0
-    """Force clip of the controller (mass-in/s^2, mass = density x in^2): pushes a 7-block
-    chain at the worst friction and density of the thesis's ranges (223) with margin. A
-    problem whose parts are heavier raises it (see :func:`push_force`)."""
-    load_margin: float = 1.5
-    """The clip is at least this many times the friction of all the problem's parts at the
-    middle of its friction and part-density ranges (:func:`push_force`)."""
-    damping_ratio: float = 1.0
-    """Damping ratio of the PD; 1 is the thesis's critically damped Kd = sqrt(4 m Kp)."""
-    wall_thickness: float = 1.0
-    """Thickness of the static wall boxes (in); far more than one step's travel."""
-    overlap_tolerance: float = 0.02
-    """Deepest overlap between shapes (in) accepted when the push starts; deeper gives
-    ``OVERLAP`` (overlapping bodies drift apart for seconds and the result means little)."""
-
-    def __post_init__(self) -> None:
-        positive = (
-            "dt",
-            "gravity",
-            "rest_interval",
-            "max_time",
-            "push_speed",
-            "push_force",
-            "load_margin",
-            "damping_ratio",
-            "wall_thickness",
-            "collision_slop",
-        )
-        for name in positive:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(
-                    f"PhysicsSettings.{name} must be positive and finite, got {value!r}"
-                )
-        for name in ("rest_linear_tol", "rest_angular_tol", "overlap_tolerance"):
-            if not getattr(self, name) >= 0:
-                raise ValueError(f"PhysicsSettings.{name} must be non-negative")
-        for name in ("iterations", "rest_checks"):
-            if getattr(self, name) < 1:
-                raise ValueError(f"PhysicsSettings.{name} must be at least 1")
-        if not 0.0 <= self.collision_bias <= 1.0:
-            raise ValueError("PhysicsSettings.collision_bias must be in [0, 1]")
-        if self.settle_steps < 0:
-            raise ValueError("PhysicsSettings.settle_steps must be non-negative")
-        if self.approach_rate * self.dt > 1.0:
-            raise ValueError(
-                "PhysicsSettings.damping_ratio must be at least 0.5 (a smaller "
-                "one makes the discrete controller overshoot)"
-            )
-
-    @property
-    def approach_rate(self) -> float:
-        """Rate (1/s) of the position loop, ``Kp / Kd = 1 / (4 damping_ratio^2 dt)``."""
-        return 1.0 / (4.0 * self.damping_ratio * self.damping_ratio * self.dt)
-
-    @property
-    def interval_steps(self) -> int:
-        """Steps between rest checks."""
-        return max(1, round(self.rest_interval / self.dt))
-
-    @property
-    def max_steps(self) -> int:
-        """Steps in ``max_time`` (the cap)."""
-        return max(1, math.ceil(self.max_time / self.dt - 1e-9))
-
-
-DEFAULT_SETTINGS = PhysicsSettings()
-
-
-def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS) -> float:
-    """The controller's force clip for ``problem``: ``settings.push_force``, raised to
-    ``load_margin`` times the table friction of every part of the problem at the middle of its
-    friction and part-density ranges when that is more.
-
-    Densities are in the problem's own mass units, so a fixed clip cannot suit every problem:
-    the thesis's noisy TT mating draws densities up to 1.0, eight times the blocks', and a clip
-    sized for blocks could not move its parts at all under nominal parameters. Scaled this way
-    the robot always pushes everything the problem has at once under nominal parameters, with
-    margin, while the heaviest, most frictional draws of a very noisy problem may still stall
-    it, as the thesis's low-gain controller stalled ("doesn't apply enough force to move the
-    desired distance when there are collisions", §2.1.3). Every shipped problem but the noisy
-    TT mating keeps the default (the largest nominal load, TT mating's, needs 398).
-    """
-    return _force_clip(problem, sum(spec.shape.area for spec in problem.parts), settings)
-
-
-def _force_clip(problem: ArrangementProblem, parts_area: float, settings: PhysicsSettings) -> float:
-    u = problem.uncertainty
-    friction = 0.5 * (u.friction[0] + u.friction[1])
-    density = 0.5 * (u.part_density[0] + u.part_density[1])
-    # Keep this product's order: simulations are chaotic to the last bit, and reassociating it
-    # changed four of tt-mating-noisy's five nominal plans (and staled their measurements).
-    return max(
-        settings.push_force,
-        settings.load_margin * settings.gravity * friction * density * parts_area,
-    )
-
-
-def pd_gains(mass: float, settings: PhysicsSettings = DEFAULT_SETTINGS) -> tuple[float, float]:
-    """``(Kp, Kd)`` of the PD the push controller is, for a paddle of ``mass`` (free motion).
-
-    ``Kd = m / dt`` (dead-beat velocity loop) and ``Kp = approach_rate * Kd``; with the default
-    ``damping_ratio = 1`` that is ``Kd = sqrt(4 m Kp)``.
-    """
-    kd = mass / settings.dt
-    return settings.approach_rate * kd, kd
 
 
 class StepStatus(enum.StrEnum):
@@ -373,130 +231,6 @@ class StepOutcome:
 
 
 # ----------------------------------------------------------------------------------------------
-# Geometry compiled once per problem
-# ----------------------------------------------------------------------------------------------
-
-
-def _abs_r_integral(poly: Sequence[tuple[float, float]]) -> float:
-    """``integral(|r| dA)`` over a convex CCW polygon, ``r`` measured from the origin.
-
-    Sum over edges of the signed integral over the triangle (origin, a, b): with ``p`` the
-    distance from the origin to the edge's line and ``t`` the coordinate along it,
-    ``integral = [p t |r| + p^3 asinh(t / p)] / 6`` between the edge's ends (polar coordinates,
-    ``integral sec^3``). Exact for the origin inside or outside the polygon.
-    """
-    total = 0.0
-    n = len(poly)
-    for i in range(n):
-        ax, ay = poly[i]
-        bx, by = poly[(i + 1) % n]
-        cross = ax * by - ay * bx
-        ex, ey = bx - ax, by - ay
-        length = math.hypot(ex, ey)
-        if length == 0.0 or cross == 0.0:
-            continue
-        p = abs(cross) / length
-        ex, ey = ex / length, ey / length
-        ta, tb = ax * ex + ay * ey, bx * ex + by * ey
-        value = (
-            p * (tb * math.hypot(bx, by) - ta * math.hypot(ax, ay))
-            + p**3 * (math.asinh(tb / p) - math.asinh(ta / p))
-        ) / 6.0
-        total += math.copysign(value, cross)
-    return total
-
-
-def _poly_area(poly: Sequence[tuple[float, float]]) -> float:
-    n = len(poly)
-    return 0.5 * sum(
-        poly[i][0] * poly[(i + 1) % n][1] - poly[(i + 1) % n][0] * poly[i][1] for i in range(n)
-    )
-
-
-@dataclass(frozen=True)
-class _Body:
-    """An object's shape, ready to build: cffi vertex arrays and per-unit-density integrals."""
-
-    kind: ObjectKind
-    parts: tuple[tuple[int, object], ...]  # (vertex count, cpVect[] array) per convex part
-    area: float
-    part_moments: tuple[tuple[float, float], ...]  # (area_i, moment of part i per unit mass)
-    abs_r: float  # integral(|r| dA) over the shape
-    push_direction: tuple[float, float]
-
-
-@dataclass(frozen=True)
-class _Compiled:
-    problem: ArrangementProblem
-    bodies: dict[str, _Body]
-    statics: tuple[tuple[int, object], ...]  # wall and obstacle polygons in world coordinates
-    table: Table
-    wall_thickness: float
-    parts_area: float  # of all the problem's parts, for the force clip (push_force)
-
-
-_IDENTITY = ffi.new("cpTransform *", (1.0, 0.0, 0.0, 1.0, 0.0, 0.0))[0]
-_CACHE: dict[int, _Compiled] = {}
-_CACHE_SIZE = 16
-
-
-def _wall_boxes(table: Table, thickness: float) -> list[tuple[tuple[float, float], ...]]:
-    w, d, t = table.width, table.depth, thickness
-    boxes = {
-        "left": (-t, -t, 0.0, d + t),
-        "right": (w, -t, w + t, d + t),
-        "bottom": (-t, -t, w + t, 0.0),
-        "top": (-t, d, w + t, d + t),
-    }
-    out = []
-    for edge in ("left", "right", "bottom", "top"):  # fixed order, whatever the file's order
-        if edge in table.walls:
-            x0, y0, x1, y1 = boxes[edge]
-            out.append(((x0, y0), (x1, y0), (x1, y1), (x0, y1)))
-    return out
-
-
-def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
-    key = id(problem)
-    hit = _CACHE.get(key)
-    if hit is not None and hit.problem is problem and hit.wall_thickness == wall_thickness:
-        return hit
-    bodies: dict[str, _Body] = {}
-    statics: list[tuple[int, object]] = []
-    for poly in _wall_boxes(problem.table, wall_thickness):
-        statics.append((len(poly), ffi.new("cpVect[]", poly)))
-    for spec in problem.objects:
-        parts = spec.shape.parts
-        if spec.kind is ObjectKind.OBSTACLE:
-            if spec.pose is None:
-                raise ValueError(f"obstacle {spec.name!r} has no pose")
-            x, y, th = spec.pose
-            c, s = math.cos(th), math.sin(th)
-            for part in parts:
-                world = [(x + c * px - s * py, y + s * px + c * py) for px, py in part]
-                statics.append((len(world), ffi.new("cpVect[]", world)))
-            continue
-        areas = [_poly_area(part) for part in parts]
-        moments = [
-            lib.cpMomentForPoly(1.0, len(part), list(part), (0.0, 0.0), 0.0) for part in parts
-        ]
-        bodies[spec.name] = _Body(
-            kind=spec.kind,
-            parts=tuple((len(part), ffi.new("cpVect[]", list(part))) for part in parts),
-            area=sum(areas),
-            part_moments=tuple(zip(areas, moments, strict=True)),
-            abs_r=sum(_abs_r_integral(part) for part in parts),
-            push_direction=spec.push_direction,
-        )
-    parts_area = sum(spec.shape.area for spec in problem.parts)  # as push_force sums it
-    compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness, parts_area)
-    if len(_CACHE) >= _CACHE_SIZE:
-        _CACHE.pop(next(iter(_CACHE)))
-    _CACHE[key] = compiled
-    return compiled
-
-
-# ----------------------------------------------------------------------------------------------
 # Simulation
 # ----------------------------------------------------------------------------------------------
 
@@ -527,29 +261,6 @@ def simulate(
     if isinstance(action, Pick):
         return _pick(compiled, state, action)
     raise ValueError(f"unknown action {action!r}: expected Place, Push or Pick")
-
-
-def rollout(
-    problem: ArrangementProblem,
-    state: WorldState,
-    actions: Sequence[Action],
-    rng: np.random.Generator,
-    settings: PhysicsSettings = DEFAULT_SETTINGS,
-) -> list[StepOutcome]:
-    """Simulate ``actions`` in turn from ``state``, drawing each one's noise from ``rng``.
-
-    Noise is drawn with :func:`arrange_up.model.world.draw_noise` (always the same amount of
-    randomness per action). Stops after the first outcome that is not ``OK``, which is the last
-    one returned.
-    """
-    outcomes: list[StepOutcome] = []
-    for action in actions:
-        outcome = simulate(problem, state, action, draw_noise(problem, action, rng), settings)
-        outcomes.append(outcome)
-        if not outcome.ok:
-            break
-        state = outcome.state
-    return outcomes
 
 
 def _check_state(compiled: _Compiled, state: WorldState) -> None:
@@ -736,9 +447,7 @@ def _push(
         px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
         paddle = lib.cpBodyNew(noise.manipulator_density * paddle_def.area, math.inf)
         add_body(paddle, paddle_def, px, py, pth)
-        ux, uy = paddle_def.push_direction
-        c, sn = math.cos(pth), math.sin(pth)
-        dx, dy = ux * c - uy * sn, ux * sn + uy * c
+        dx, dy = rotate(paddle_def.push_direction, pth)
 
         # 4. settle, then look for overlaps in the contacts the engine built
         for _ in range(s.settle_steps):

@@ -50,6 +50,7 @@ from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
 from arrange_up.cbst.model import load_model
 from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
 
@@ -166,8 +167,7 @@ class CBSTSemantics:
         problem = self.problem
         spec = problem.object(push.manipulator)
         px, py = spec.push_direction
-        c, s = math.cos(push.pose[2]), math.sin(push.pose[2])
-        frame = CanonicalFrame.of_vector(c * px - s * py, s * px + c * py)
+        frame = CanonicalFrame.of_vector(*rotate((px, py), push.pose[2]))
         if frame is None:
             return self._refuse("the push is not axis-aligned")
         d = self.block_size

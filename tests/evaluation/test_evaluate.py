@@ -7,7 +7,9 @@ from __future__ import annotations
 import json
 import math
 import sys
+from dataclasses import replace
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -22,6 +24,7 @@ from arrange_up.evaluation.evaluate import (
     RolloutRecord,
     _RecordFile,
     evaluate_plan,
+    execute_plan,
     plan_hash,
     simulate_rollout,
     trace_rollout,
@@ -29,8 +32,16 @@ from arrange_up.evaluation.evaluate import (
 )
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, write_json_atomic
-from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind, ObjectSpec, Shape, Table
-from arrange_up.model.world import Pick, Place, Push
+from arrange_up.model.problem import (
+    ArrangementProblem,
+    Goal,
+    ObjectKind,
+    ObjectSpec,
+    Shape,
+    Table,
+    Uncertainty,
+)
+from arrange_up.model.world import Pick, Place, Push, WorldState
 from arrange_up.planning.planner import plan
 
 EAST = -math.pi / 2  # paddle theta that pushes toward +x
@@ -148,8 +159,6 @@ def test_off_table_and_not_at_rest_are_told_apart(monkeypatch):
     def capped(problem, state, action, noise=None, settings=physics.DEFAULT_SETTINGS):
         outcome = real(problem, state, action, noise, settings)
         if isinstance(action, Push):
-            from dataclasses import replace
-
             return replace(outcome, status=physics.StepStatus.NOT_AT_REST)
         return outcome
 
@@ -157,6 +166,30 @@ def test_off_table_and_not_at_rest_are_told_apart(monkeypatch):
     result = evaluate_plan(problem, push_off, rollouts=2, workers=1)
     assert result.failures.not_at_rest == 2
     assert result.failures.not_at_rest_actions[0] == (1, 2)
+
+
+def test_execution_draws_noise_and_stops_at_the_first_failure():
+    problem = replace(
+        _open_right(),
+        uncertainty=Uncertainty(
+            place=(0.02, 0.02, 0.01), push=(0.01, 0.01, 0.005), friction=(0.3, 0.5)
+        ),
+    )
+    state = WorldState.from_mapping(problem, {"B": (2.0, 1.0, 0.0)})
+    actions = [
+        Place("A", (8.0, 2.5, 0.0)),
+        Push("paddle", (7.325, 2.5, EAST), 3.0),  # off the open right edge
+        Pick("B"),
+    ]
+    run = execute_plan(problem, state, actions, np.random.default_rng(3))
+    assert not run.ok and run.failure.kind == OFF_TABLE and run.failure.action == 1
+    assert len(run.states) == 2 and run.states[0] == state
+    assert run.state.pose("A") != (8.0, 2.5, 0.0)  # noise was drawn
+    again = execute_plan(problem, state, actions, np.random.default_rng(3))
+    assert again == run
+    fine = execute_plan(problem, state, [actions[0], Pick("B")], np.random.default_rng(3))
+    assert fine.ok and fine.state.names() == ("A",)
+    assert fine.states[1] == run.states[1]
 
 
 def test_bad_arguments_are_refused(blocks1):

@@ -1,4 +1,5 @@
-"""Tests of arrange_up.physics.simulation: place, pick and push on small problems built in code."""
+"""Tests of arrange_up.physics (simulation, bodies, settings): place, pick and push on small
+problems built in code."""
 
 from __future__ import annotations
 
@@ -21,15 +22,14 @@ from arrange_up.model.problem import (
     Uncertainty,
 )
 from arrange_up.model.world import ActionNoise, Pick, Place, Push, WorldState
+from arrange_up.physics.bodies import _abs_r_integral
 from arrange_up.physics.simulation import (
     DEFAULT_SETTINGS,
     PhysicsSettings,
     StepStatus,
-    _abs_r_integral,
     _drive_trajectory,
     pd_gains,
     push_force,
-    rollout,
     simulate,
 )
 
@@ -367,30 +367,6 @@ def test_push_is_bit_identical_across_processes():
     with redirect_stdout(buffer):
         exec(_DETERMINISM_SCRIPT, namespace)
     assert buffer.getvalue() in outputs
-
-
-def test_rollout_draws_noise_and_stops_at_first_failure():
-    problem = make_problem(
-        2,
-        walls=("left", "bottom", "top"),
-        uncertainty=Uncertainty(
-            place=(0.02, 0.02, 0.01), push=(0.01, 0.01, 0.005), friction=(0.3, 0.5)
-        ),
-    )
-    state = state_of(problem, b1=(2.0, 1.0, 0.0))
-    actions = [
-        Place("b0", (8.0, 2.5, 0.0)),
-        push_east(8.0, 2.5, 3.0, gap=0.1),  # off the open right edge
-        Pick("b1"),
-    ]
-    outcomes = rollout(problem, state, actions, np.random.default_rng(3))
-    assert [o.status for o in outcomes] == [StepStatus.OK, StepStatus.OFF_TABLE]
-    assert outcomes[0].state.pose("b0") != (8.0, 2.5, 0.0)  # noise was drawn
-    again = rollout(problem, state, actions, np.random.default_rng(3))
-    assert [o.state for o in again] == [o.state for o in outcomes]
-    fine = rollout(problem, state, [actions[0], Pick("b1")], np.random.default_rng(3))
-    assert [o.ok for o in fine] == [True, True]
-    assert fine[-1].state.names() == ("b0",)
 
 
 # --- geometry of table friction ----------------------------------------------------------------

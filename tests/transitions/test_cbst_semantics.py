@@ -11,11 +11,11 @@ import pytest
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief
 from arrange_up.cbst.features import BUCKLE_LIMIT
+from arrange_up.evaluation.rollouts import execute_plan
 from arrange_up.io.domains import load, resolve_problem
 from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.problem import InitialObject
 from arrange_up.model.world import Pick, Place, Push, WorldState
-from arrange_up.physics.simulation import rollout
 from arrange_up.planning.planner import plan
 from arrange_up.transitions import available, make_semantics
 from arrange_up.transitions.cbst import CBSTSemantics
@@ -184,8 +184,8 @@ def test_predicted_boxes_contain_simulated_outcomes():
 
 def _simulate_plan(problem, actions, seed: int) -> WorldState | None:
     rng = np.random.default_rng(seed)
-    outcomes = rollout(problem, WorldState(()), actions, rng)
-    return outcomes[-1].state if all(o.ok for o in outcomes) else None
+    run = execute_plan(problem, WorldState(()), actions, rng)
+    return run.state if run.ok else None
 
 
 @pytest.mark.parametrize("name", ["blocks-1", "blocks-2"])

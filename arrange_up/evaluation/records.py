@@ -1,0 +1,180 @@
+"""Record files: the resumable ``.jsonl`` of an evaluation's rollouts.
+
+With ``record=PATH`` every finished rollout is appended to ``PATH`` at once as one JSON line
+(flushed), after a header line identifying the evaluation (format, problem hash, plan hash,
+seed, physics settings). Running again with the same file resumes: rollouts already recorded
+are read back, not re-run, and the result is identical to an uninterrupted run's. A file whose
+header identifies another evaluation is refused (:class:`RecordFileError`), never mixed. A run
+killed halfway keeps every rollout that reached the file; with a process pool a rollout reaches
+it when its chunk (a few rollouts, see :mod:`arrange_up.parallel`) comes back. A line cut off by
+the kill is dropped on resume. The file is locked while a run writes to it. See
+``docs/evaluation.md`` for the line format.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import IO, Any
+
+from arrange_up.evaluation.outcomes import RolloutRecord
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action, Pick, Place, Push
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not on POSIX: files are not locked
+    fcntl = None
+
+__all__ = ["RECORD_FORMAT", "RecordFile", "RecordFileError", "plan_hash", "record_header"]
+
+RECORD_FORMAT = "arrange-up-rollouts/1"
+
+
+class RecordFileError(ValueError):
+    """A record file that belongs to another evaluation, is corrupt, or is in use."""
+
+
+def plan_hash(actions: Sequence[Action]) -> str:
+    """A content hash of a plan's actions (internal units, exact floats): ``"sha256:<hex>"``."""
+
+    def canonical(action: Action) -> list[Any]:
+        if isinstance(action, Place):
+            return ["place", action.obj, [float(v) for v in action.pose]]
+        if isinstance(action, Push):
+            return [
+                "push",
+                action.manipulator,
+                [float(v) for v in action.pose],
+                float(action.distance),
+            ]
+        if isinstance(action, Pick):
+            return ["pick", action.obj]
+        raise TypeError(f"not an action: {action!r}")
+
+    text = json.dumps([canonical(a) for a in actions], separators=(",", ":"))
+    return "sha256:" + hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def record_header(
+    problem: ArrangementProblem, phash: str, lhash: str, n: int, seed: int, settings: object
+) -> dict:
+    """The header line of an evaluation's record file: ``phash`` and ``lhash`` are the problem
+    and plan hashes, ``n`` the plan's length, ``settings`` the physics settings (hashed)."""
+    return {
+        "format": RECORD_FORMAT,
+        "problem": {"name": problem.name, "hash": phash},
+        "plan": {"hash": lhash, "actions": n},
+        "seed": seed,
+        "physics": hashlib.sha256(repr(settings).encode("utf-8")).hexdigest()[:16],
+    }
+
+
+_HEADER_KEYS: tuple[tuple[str, ...], ...] = (
+    ("format",),
+    ("problem", "hash"),
+    ("plan", "hash"),
+    ("seed",),
+    ("physics",),
+)
+
+
+def _dig(data: Any, path: tuple[str, ...]) -> Any:
+    for key in path:
+        data = data.get(key) if isinstance(data, dict) else None
+    return data
+
+
+class RecordFile:
+    """An open, locked record file: its earlier records (``records``, by index), and an append
+    handle (:meth:`write_line`). Opening a file of another evaluation, or one in use, raises
+    :class:`RecordFileError`."""
+
+    def __init__(self, path: Path, header: dict) -> None:
+        self.path = path
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.handle: IO[bytes] = open(path, "a+b")  # noqa: SIM115 - closed by close()
+        try:
+            self._lock()
+            self.records = self._read(header)
+        except BaseException:
+            self.handle.close()
+            raise
+
+    def _lock(self) -> None:
+        if fcntl is None:  # pragma: no cover - not on POSIX
+            return
+        try:
+            fcntl.flock(self.handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise RecordFileError(
+                f"{self.path}: the record file is in use by another evaluation"
+            ) from None
+
+    def _read(self, header: dict) -> dict[int, RolloutRecord]:
+        handle = self.handle
+        handle.seek(0)
+        data = handle.read()
+        if not data.strip():
+            handle.truncate(0)
+            self.write_line(header)
+            return {}
+        lines = data.split(b"\n")
+        if not data.endswith(b"\n"):
+            # the last line was cut off (a run killed while writing): drop it
+            lines, cut = lines[:-1], lines[-1]
+            handle.truncate(len(data) - len(cut))
+        else:
+            lines = lines[:-1]
+        if not lines:  # killed while writing the header: start afresh
+            self.write_line(header)
+            return {}
+        try:
+            found = json.loads(lines[0])
+        except ValueError:
+            found = None
+        if not isinstance(found, dict) or found.get("format") != RECORD_FORMAT:
+            raise RecordFileError(
+                f"{self.path}:1: not an arrange-up rollout record (its first line must be a "
+                f"{RECORD_FORMAT!r} header); use another record file"
+            )
+        differ = [
+            ".".join(path) for path in _HEADER_KEYS if _dig(found, path) != _dig(header, path)
+        ]
+        if differ:
+            details = "; ".join(
+                f"{'.'.join(p)}: file {_dig(found, p)!r}, this run {_dig(header, p)!r}"
+                for p in _HEADER_KEYS
+                if ".".join(p) in differ
+            )
+            raise RecordFileError(
+                f"{self.path}: the record file belongs to another evaluation ({details}); its "
+                "rollouts cannot be mixed with this one's: use another record file or delete it"
+            )
+        records: dict[int, RolloutRecord] = {}
+        for number, line in enumerate(lines[1:], start=2):
+            if not line.strip():
+                continue
+            try:
+                record = RolloutRecord.from_json(json.loads(line))
+            except (ValueError, KeyError, TypeError) as error:
+                raise RecordFileError(
+                    f"{self.path}:{number}: not a rollout record: {error}"
+                ) from None
+            earlier = records.get(record.index)
+            if earlier is not None and earlier != record:
+                raise RecordFileError(
+                    f"{self.path}:{number}: rollout {record.index} is recorded twice with "
+                    "different outcomes"
+                )
+            records[record.index] = record
+        return records
+
+    def write_line(self, data: dict) -> None:
+        self.handle.write(json.dumps(data, separators=(",", ":")).encode("utf-8") + b"\n")
+        self.handle.flush()
+
+    def close(self) -> None:
+        self.handle.close()  # also releases the lock

@@ -1,0 +1,236 @@
+"""Rollouts: a plan executed open-loop in the physics under freshly drawn noise, judged as it
+runs. This is the only loop that executes a sequence of actions in simulation.
+
+Rollout ``i`` draws everything from one generator, ``numpy.random.default_rng([seed, i])``, so
+its outcome depends only on ``(seed, i)``: not on the backend, the worker count, the chunking
+or the order in which rollouts finish. In that stream, in this order:
+
+1. The initial poses: each object of the initial belief uniformly within its interval
+   (``problem.initial``), redrawn until nothing overlaps (rejection sampling,
+   :func:`arrange_up.belief.states.sample_initial_particles`).
+2. For every action in turn, its noise (:func:`arrange_up.model.world.draw_noise`: place and push
+   pose offsets, friction, part and manipulator densities, drawn fresh per action), then the
+   action is simulated (:func:`arrange_up.physics.simulation.simulate`).
+3. At the end, the goal test (:class:`arrange_up.belief.goals.GoalTest`).
+
+The rollout fails at the first of these (and records which):
+
+* ``action_failed``: the action cannot be applied: the physics refuses it (placing an object
+  already on the table, pushing with a manipulator that is on the table, picking an object that
+  is not there: the physics' ``ValueError``, whose message is the reason); a push starts with
+  shapes overlapping by more than the physics' ``overlap_tolerance`` (0.02 in; the paddle was
+  put down on a part); or a place puts its object overlapping another object, a wall or an
+  obstacle by more than that tolerance (the physics does not check places).
+* ``not_at_rest``: a push's simulation hit its time cap before everything came to rest.
+* ``off_table``: an object's centroid ended outside the table (open edges).
+* ``goal_missed``: the plan ran through, but at least one goal part misses its tolerance (the
+  record says which parts, in which dimensions ``x``, ``y``, ``theta``, by how much beyond the
+  tolerance, or ``off table`` when a goal part is not on the table).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from arrange_up.belief.goals import GoalTest
+from arrange_up.belief.states import AngleFrame, sample_initial_particles
+from arrange_up.evaluation.outcomes import (
+    ACTION_FAILED,
+    GOAL_MISSED,
+    NOT_AT_REST,
+    OFF_TABLE,
+    Failure,
+    GoalMiss,
+    RolloutRecord,
+)
+from arrange_up.geometry.collision import PenetrationDepths
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action, Place, WorldState, draw_noise
+from arrange_up.physics import simulation  # simulate looked up per call: tests replace it
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus
+
+__all__ = [
+    "PUSH_OVERLAP_REASON",
+    "Execution",
+    "RolloutContext",
+    "Rollouts",
+    "execute_plan",
+    "rollout_task",
+    "simulate_rollout",
+    "trace_rollout",
+]
+
+PUSH_OVERLAP_REASON = "the push started with shapes overlapping"
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Actions executed from a state: ``states`` holds the state it started from, then the
+    state after each action, up to the one that failed (whose state is not included);
+    ``failure`` is ``None`` when every action went through."""
+
+    states: tuple[WorldState, ...]
+    failure: Failure | None
+
+    @property
+    def state(self) -> WorldState:
+        """The last state reached."""
+        return self.states[-1]
+
+    @property
+    def ok(self) -> bool:
+        return self.failure is None
+
+
+class Rollouts:
+    """The rollouts of one plan on one problem: what they need, built once (goal test, angle
+    frame, penetration depths), and the loop that runs them."""
+
+    def __init__(
+        self,
+        problem: ArrangementProblem,
+        actions: Sequence[Action],
+        settings: PhysicsSettings = DEFAULT_SETTINGS,
+    ) -> None:
+        self.problem = problem
+        self.actions = tuple(actions)
+        self.settings = settings
+        self.goal = GoalTest(problem)
+        self.frame = AngleFrame.of(problem)
+        self.depths = PenetrationDepths(problem)
+
+    def run(self, seed: int, index: int, trace: list[WorldState] | None = None) -> RolloutRecord:
+        """Rollout ``index`` of an evaluation with ``seed``; the states it passes through are
+        appended to ``trace`` when given (as :attr:`Execution.states`)."""
+        rng = np.random.default_rng([seed, index])
+        state = sample_initial_particles(self.problem, 1, rng, frame=self.frame).particles[0]
+        states = [] if trace is None else trace
+        states.append(state)
+        state, failure = self._execute(state, rng, states)
+        if failure is not None:
+            return RolloutRecord(index, False, failure)
+        misses = self.goal.misses(state)
+        if misses:
+            failure = Failure(
+                GOAL_MISSED,
+                misses=tuple(
+                    GoalMiss(m.part, m.dimensions(), tuple(float(e) for e in m.excess))  # type: ignore[arg-type]
+                    for m in misses
+                ),
+            )
+            return RolloutRecord(index, False, failure)
+        return RolloutRecord(index, True)
+
+    def execute(self, state: WorldState, rng: np.random.Generator) -> Execution:
+        """The plan's actions from ``state``, each one's noise drawn from ``rng`` just before it
+        is simulated; stops at the first failure (no goal test)."""
+        states = [state]
+        _, failure = self._execute(state, rng, states)
+        return Execution(tuple(states), failure)
+
+    def _execute(
+        self, state: WorldState, rng: np.random.Generator, states: list[WorldState]
+    ) -> tuple[WorldState, Failure | None]:
+        """The one loop: ``(last state, failure or None)``, each state reached appended."""
+        problem = self.problem
+        tolerance = self.settings.overlap_tolerance
+        for k, action in enumerate(self.actions):
+            noise = draw_noise(problem, action, rng)
+            try:
+                outcome = simulation.simulate(problem, state, action, noise, self.settings)
+            except ValueError as error:
+                return state, Failure(ACTION_FAILED, k, str(error))
+            if outcome.status is StepStatus.OVERLAP:
+                return state, Failure(
+                    ACTION_FAILED,
+                    k,
+                    f"{PUSH_OVERLAP_REASON} (by more than {tolerance:g} in)",
+                    f"deepest overlap {outcome.overlap:.4f} in",
+                )
+            if outcome.status is StepStatus.NOT_AT_REST:
+                return state, Failure(NOT_AT_REST, k)
+            if outcome.status is StepStatus.OFF_TABLE:
+                return state, Failure(OFF_TABLE, k, objects=tuple(outcome.off_table))
+            state = outcome.state
+            if isinstance(action, Place):
+                other, depth = self.depths.deepest(state, action.obj)
+                if depth > tolerance:
+                    return state, Failure(
+                        ACTION_FAILED,
+                        k,
+                        f"placed overlapping {other} (by more than {tolerance:g} in)",
+                        f"overlap {depth:.4f} in",
+                    )
+            states.append(state)
+        return state, None
+
+
+def execute_plan(
+    problem: ArrangementProblem,
+    state: WorldState,
+    actions: Sequence[Action],
+    rng: np.random.Generator,
+    settings: PhysicsSettings = DEFAULT_SETTINGS,
+) -> Execution:
+    """Execute ``actions`` from ``state`` as a rollout does (noise drawn from ``rng`` per
+    action, the same failures), without sampling the start or testing the goal."""
+    return Rollouts(problem, actions, settings).execute(state, rng)
+
+
+def simulate_rollout(
+    problem: ArrangementProblem, actions: Sequence[Action], seed: int, index: int
+) -> RolloutRecord:
+    """Run rollout ``index`` of an evaluation with ``seed`` (see the module docstring).
+
+    The same ``(seed, index)`` always gives the same record; use it to replay one rollout of
+    an evaluation (:func:`trace_rollout` gives its states).
+    """
+    return Rollouts(problem, actions).run(seed, index)
+
+
+def trace_rollout(
+    problem: ArrangementProblem, actions: Sequence[Action], seed: int, index: int
+) -> tuple[WorldState, ...]:
+    """The world states of rollout ``index`` (the same rollout
+    :func:`~arrange_up.evaluation.evaluate.evaluate_plan` runs with ``seed``): the initial
+    state, then the state after each action, cut short where the rollout failed (the failing
+    action's state is not included; a rollout that only missed the goal has all
+    ``len(actions) + 1`` states)."""
+    states: list[WorldState] = []
+    Rollouts(problem, actions).run(seed, index, states)
+    return tuple(states)
+
+
+@dataclass(frozen=True)
+class RolloutContext:
+    """What a worker needs to run rollouts of one evaluation (pickled with each task); ``key``
+    identifies the evaluation (its problem and plan hashes)."""
+
+    key: str
+    problem: ArrangementProblem
+    actions: tuple[Action, ...]
+    seed: int
+
+
+def rollout_task(context: RolloutContext, index: int) -> RolloutRecord:
+    """Rollout ``index`` of ``context``'s evaluation, reusing this process's :class:`Rollouts`
+    of it."""
+    return _cached(context).run(context.seed, index)
+
+
+_CACHE: dict[str, Rollouts] = {}
+
+
+def _cached(context: RolloutContext) -> Rollouts:
+    # Keyed by the problem and plan hashes: a worker receiving the same evaluation's problem
+    # again (a fresh unpickled copy per task) reuses the first copy, and with it the physics'
+    # per-problem cache.
+    hit = _CACHE.get(context.key)
+    if hit is None:
+        if len(_CACHE) >= 8:
+            _CACHE.pop(next(iter(_CACHE)))
+        hit = _CACHE[context.key] = Rollouts(context.problem, context.actions)
+    return hit

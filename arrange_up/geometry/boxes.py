@@ -1,0 +1,129 @@
+"""Axis-aligned boxes ``(xmin, ymin, xmax, ymax)``: bounding boxes, overlap and containment,
+sweeps, and the table's walls."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+import shapely.geometry.base
+
+from arrange_up.geometry.polygons import Polygon, _points_array
+
+Box = tuple[float, float, float, float]
+"""``(xmin, ymin, xmax, ymax)``."""
+
+WALL_NAMES: tuple[str, ...] = ("left", "right", "bottom", "top")
+
+__all__ = [
+    "WALL_NAMES",
+    "Box",
+    "box_contains",
+    "box_corners",
+    "box_of",
+    "boxes_overlap",
+    "swept_box",
+    "wall_boxes",
+]
+
+
+def box_of(geom_or_points) -> Box:
+    """Bounding box of a shapely geometry, an ``(N, 2)`` point set, or a sequence of polygons.
+
+    Raises ``ValueError`` for empty input.
+    """
+    if isinstance(geom_or_points, shapely.geometry.base.BaseGeometry):
+        if geom_or_points.is_empty:
+            raise ValueError("empty geometry has no bounding box")
+        xmin, ymin, xmax, ymax = geom_or_points.bounds
+        return (float(xmin), float(ymin), float(xmax), float(ymax))
+    try:
+        p = _points_array(geom_or_points)
+    except ValueError:  # ragged: a sequence of polygons (e.g. a shape's parts)
+        p = np.concatenate([_points_array(poly) for poly in geom_or_points])
+    if p.ndim == 3:  # equal-length polygons stack into (K, M, 2)
+        p = p.reshape(-1, 2)
+    if len(p) == 0:
+        raise ValueError("no points: no bounding box")
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+
+
+def boxes_overlap(a: Box, b: Box, tol: float = 0.0) -> bool:
+    """Whether the interiors of ``a`` and ``b`` overlap by more than ``tol`` along both axes.
+
+    Boxes that only touch (shared edge or corner) do not overlap for ``tol >= 0``; a negative
+    ``tol`` makes near-misses count as overlapping (a safety margin).
+    """
+    return (min(a[2], b[2]) - max(a[0], b[0]) > tol) and (min(a[3], b[3]) - max(a[1], b[1]) > tol)
+
+
+def box_contains(outer: Box, inner: Box, tol: float = 1e-9) -> bool:
+    """Whether ``inner`` lies inside ``outer`` (boundaries may touch), allowing ``tol`` slack."""
+    return (
+        inner[0] >= outer[0] - tol
+        and inner[1] >= outer[1] - tol
+        and inner[2] <= outer[2] + tol
+        and inner[3] <= outer[3] + tol
+    )
+
+
+def swept_box(box: Box, direction: tuple[float, float], distance: float) -> Box:
+    """The region ``box`` covers while translated by ``distance`` along ``direction``.
+
+    ``direction`` must be an axis-aligned unit vector (``(±1, 0)`` or ``(0, ±1)``) and
+    ``distance >= 0``; the box grows on the side it moves towards. Raises ``ValueError``
+    otherwise.
+    """
+    ux, uy = direction
+    if not distance >= 0.0:
+        raise ValueError(f"sweep distance must be non-negative, got {distance}")
+    xmin, ymin, xmax, ymax = box
+    if (ux, uy) == (1, 0):
+        return (xmin, ymin, xmax + distance, ymax)
+    if (ux, uy) == (-1, 0):
+        return (xmin - distance, ymin, xmax, ymax)
+    if (ux, uy) == (0, 1):
+        return (xmin, ymin, xmax, ymax + distance)
+    if (ux, uy) == (0, -1):
+        return (xmin, ymin - distance, xmax, ymax)
+    raise ValueError(f"direction must be (+-1, 0) or (0, +-1), got {direction}")
+
+
+def wall_boxes(
+    table_size: tuple[float, float], walls: Iterable[str], thickness: float = 1.0
+) -> dict[str, Box]:
+    """Boxes of rigid walls just outside the edges of the table ``[0, W] x [0, D]``.
+
+    ``"left"`` is ``[-thickness, 0] x [-thickness, D + thickness]`` (it spans the table's side
+    plus both corners, so walls meeting at a corner leave no gap); ``"right"`` is
+    ``[W, W + thickness]`` over the same y range; ``"bottom"`` is
+    ``[-thickness, W + thickness] x [-thickness, 0]`` and ``"top"`` the same x range over
+    ``[D, D + thickness]``. Returned in the order given (duplicates collapse).
+
+    Raises ``ValueError`` for an unknown wall name or a non-positive size or thickness.
+    """
+    w, d = table_size
+    if not (w > 0 and d > 0 and thickness > 0):
+        raise ValueError(
+            f"table size and wall thickness must be positive: {table_size}, {thickness}"
+        )
+    t = thickness
+    all_walls: dict[str, Box] = {
+        "left": (-t, -t, 0.0, d + t),
+        "right": (w, -t, w + t, d + t),
+        "bottom": (-t, -t, w + t, 0.0),
+        "top": (-t, d, w + t, d + t),
+    }
+    out: dict[str, Box] = {}
+    for name in walls:
+        if name not in all_walls:
+            raise ValueError(f"unknown wall {name!r}; expected one of {', '.join(WALL_NAMES)}")
+        out[name] = all_walls[name]
+    return out
+
+
+def box_corners(box: Box) -> Polygon:
+    """The corners of ``box``, CCW from ``(xmin, ymin)``."""
+    x0, y0, x1, y1 = box
+    return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))

@@ -1,0 +1,157 @@
+"""The settings of the simulation (:class:`PhysicsSettings`, :data:`DEFAULT_SETTINGS`) and the
+controller's force clip and gains derived from them. The model they parameterise is described
+in :mod:`arrange_up.physics.simulation`."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from arrange_up.model.problem import ArrangementProblem
+
+__all__ = ["DEFAULT_SETTINGS", "PhysicsSettings", "pd_gains", "push_force"]
+
+
+@dataclass(frozen=True)
+class PhysicsSettings:
+    """Numerical and controller settings of the simulation (inches, seconds, radians).
+
+    Every default is argued in :mod:`arrange_up.physics.simulation` or measured in
+    ``docs/design/physics.md``.
+    """
+
+    dt: float = 1.0 / 240.0
+    """Time step. 1/60 is too coarse for chains of blocks (see ``docs/design/physics.md``)."""
+    iterations: int = 10
+    """Solver iterations per step (10: the safe end of the accurate range at dt 1/240)."""
+    collision_slop: float = 0.005
+    """Allowed resting overlap (in). pymunk's default 0.1 is sized for pixels."""
+    collision_bias: float = 0.8**240
+    """Fraction of an overlap beyond the slop left uncorrected after one second: ``0.8 ** 240``
+    corrects 20% per step at dt 1/240 (Box2D's Baumgarte factor; pymunk's default ``0.9 ** 60``
+    is 2.6% per step and lets squeezed chains creep for a second, see
+    :mod:`arrange_up.physics.simulation`)."""
+    gravity: float = 386.09
+    """Standard gravity in in/s^2; only the table friction uses it (the world is top-down)."""
+    rest_interval: float = 0.1
+    """Simulated time between rest checks (s); rounded to whole steps (24 at dt 1/240)."""
+    rest_linear_tol: float = 1e-3
+    """A body is still when it moved less than this (in) since the previous check..."""
+    rest_angular_tol: float = 1e-3
+    """...and turned less than this (rad)."""
+    rest_checks: int = 2
+    """Consecutive still checks that make rest (one can be a momentary stop)."""
+    max_time: float = 20.0
+    """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
+    settle_steps: int = 2
+    """Steps run after writing the state, before driving the manipulator: the thesis ran "a
+    couple of time steps" so the engine builds its contact state first. The overlap check reads
+    the contacts they build (0 turns the check off)."""
+    push_speed: float = 3.0
+    """Speed limit of the manipulator (in/s): a careful robot push, 0.0125 in per step."""
+    push_force: float = 400.0
+    """Force clip of the controller (mass-in/s^2, mass = density x in^2): pushes a 7-block
+    chain at the worst friction and density of the thesis's ranges (223) with margin. A
+    problem whose parts are heavier raises it (see :func:`push_force`)."""
+    load_margin: float = 1.5
+    """The clip is at least this many times the friction of all the problem's parts at the
+    middle of its friction and part-density ranges (:func:`push_force`)."""
+    damping_ratio: float = 1.0
+    """Damping ratio of the PD; 1 is the thesis's critically damped Kd = sqrt(4 m Kp)."""
+    wall_thickness: float = 1.0
+    """Thickness of the static wall boxes (in); far more than one step's travel."""
+    overlap_tolerance: float = 0.02
+    """Deepest overlap between shapes (in) accepted when the push starts; deeper gives
+    ``OVERLAP`` (overlapping bodies drift apart for seconds and the result means little)."""
+
+    def __post_init__(self) -> None:
+        positive = (
+            "dt",
+            "gravity",
+            "rest_interval",
+            "max_time",
+            "push_speed",
+            "push_force",
+            "load_margin",
+            "damping_ratio",
+            "wall_thickness",
+            "collision_slop",
+        )
+        for name in positive:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(
+                    f"PhysicsSettings.{name} must be positive and finite, got {value!r}"
+                )
+        for name in ("rest_linear_tol", "rest_angular_tol", "overlap_tolerance"):
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"PhysicsSettings.{name} must be non-negative")
+        for name in ("iterations", "rest_checks"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"PhysicsSettings.{name} must be at least 1")
+        if not 0.0 <= self.collision_bias <= 1.0:
+            raise ValueError("PhysicsSettings.collision_bias must be in [0, 1]")
+        if self.settle_steps < 0:
+            raise ValueError("PhysicsSettings.settle_steps must be non-negative")
+        if self.approach_rate * self.dt > 1.0:
+            raise ValueError(
+                "PhysicsSettings.damping_ratio must be at least 0.5 (a smaller "
+                "one makes the discrete controller overshoot)"
+            )
+
+    @property
+    def approach_rate(self) -> float:
+        """Rate (1/s) of the position loop, ``Kp / Kd = 1 / (4 damping_ratio^2 dt)``."""
+        return 1.0 / (4.0 * self.damping_ratio * self.damping_ratio * self.dt)
+
+    @property
+    def interval_steps(self) -> int:
+        """Steps between rest checks."""
+        return max(1, round(self.rest_interval / self.dt))
+
+    @property
+    def max_steps(self) -> int:
+        """Steps in ``max_time`` (the cap)."""
+        return max(1, math.ceil(self.max_time / self.dt - 1e-9))
+
+
+DEFAULT_SETTINGS = PhysicsSettings()
+
+
+def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS) -> float:
+    """The controller's force clip for ``problem``: ``settings.push_force``, raised to
+    ``load_margin`` times the table friction of every part of the problem at the middle of its
+    friction and part-density ranges when that is more.
+
+    Densities are in the problem's own mass units, so a fixed clip cannot suit every problem:
+    the thesis's noisy TT mating draws densities up to 1.0, eight times the blocks', and a clip
+    sized for blocks could not move its parts at all under nominal parameters. Scaled this way
+    the robot always pushes everything the problem has at once under nominal parameters, with
+    margin, while the heaviest, most frictional draws of a very noisy problem may still stall
+    it, as the thesis's low-gain controller stalled ("doesn't apply enough force to move the
+    desired distance when there are collisions", §2.1.3). Every shipped problem but the noisy
+    TT mating keeps the default (the largest nominal load, TT mating's, needs 398).
+    """
+    return _force_clip(problem, sum(spec.shape.area for spec in problem.parts), settings)
+
+
+def _force_clip(problem: ArrangementProblem, parts_area: float, settings: PhysicsSettings) -> float:
+    u = problem.uncertainty
+    friction = 0.5 * (u.friction[0] + u.friction[1])
+    density = 0.5 * (u.part_density[0] + u.part_density[1])
+    # Keep this product's order: simulations are chaotic to the last bit, and reassociating it
+    # changed four of tt-mating-noisy's five nominal plans (and staled their measurements).
+    return max(
+        settings.push_force,
+        settings.load_margin * settings.gravity * friction * density * parts_area,
+    )
+
+
+def pd_gains(mass: float, settings: PhysicsSettings = DEFAULT_SETTINGS) -> tuple[float, float]:
+    """``(Kp, Kd)`` of the PD the push controller is, for a paddle of ``mass`` (free motion).
+
+    ``Kd = m / dt`` (dead-beat velocity loop) and ``Kp = approach_rate * Kd``; with the default
+    ``damping_ratio = 1`` that is ``Kd = sqrt(4 m Kp)``.
+    """
+    kd = mass / settings.dt
+    return settings.approach_rate * kd, kd
