@@ -306,6 +306,9 @@ def from_up(up_problem: Any) -> ArrangementProblem:
       :class:`~arrange_up.model.errors.ProblemFormatError` (a ``ValueError``) when it does not fit
       the vocabulary. Names are as UP read them: lowercase, since PDDL is case-insensitive
       (:func:`arrange_up.io.pddl.load_pddl_problem` restores the written case from the file).
+    * Anything else, refused with ``ValueError`` before any reading: a problem that is not a
+      plain UP ``Problem`` (scheduling, hierarchical, multi-agent, contingent, ...) or has a
+      feature outside :data:`READABLE_KIND`.
     """
     effect = _effect_of(up_problem)
     if effect is None:

@@ -26,7 +26,7 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
 * ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
   watches the clock itself.
 * ``UNSUPPORTED_PROBLEM``: the problem is not an arrange-up problem; ``INTERNAL_ERROR``: the
-  planner failed. Both with a log message saying why.
+  planner failed, or reading the problem did. Both with a log message saying why.
 
 Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` (default
 ``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000).
@@ -41,7 +41,10 @@ that failed most often), ``UNKNOWN`` when the problem or the plan cannot be conv
 evaluation fails. Metrics: ``successes``, ``trials``, ``rate``, ``interval`` (the 95% Wilson
 interval as ``[low, high]``), ``interval_low``, ``interval_high``, ``seed``, ``elapsed`` and the
 failure counts per kind. Parameters: ``rollouts`` (1000), ``seed`` (0), ``workers`` (``None``:
-all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address).
+all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address),
+``timeout`` (seconds, ``None``: none). unified-planning's ``validate`` takes no timeout, so it
+is a parameter; it is checked as rollouts finish, and when it runs out the answer is ``UNKNOWN``
+with a log message saying how many rollouts were done.
 
     >>> from unified_planning.shortcuts import PlanValidator
     >>> with PlanValidator(name="arrange-up-reliability", params={"rollouts": 100}) as v:
@@ -49,12 +52,35 @@ all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask sched
     >>> check.metrics["successes"], check.metrics["interval"]     # doctest: +SKIP
     ('100', '[0.963, 1]')
 
-**The repairer** (:class:`ArrangeUpFixtureRepairer`): see its docstring.
+**The repairer** (:class:`ArrangeUpFixtureRepairer`): see its docstring. It answers
+``SOLVED_SATISFICING`` only with a plan that reaches the goal in the deterministic semantics.
+
+**Every engine answers, none raises** on any problem or plan unified-planning can build: a
+problem that is not an arrange-up one is refused with a status (``UNSUPPORTED_PROBLEM``;
+``UNKNOWN`` from the validator) and a log message, a failure inside arrange-up is reported as
+``INTERNAL_ERROR`` (``UNKNOWN``) with the exception named. Only the parameters are checked when
+the engine is made: a bad value raises ``ValueError``, an unknown name ``TypeError`` naming the
+accepted ones.
+
+**Kinds and guarantees.** ``supports(kind)`` is true for exactly the kind of the problems
+:func:`~arrange_up.up.compile.to_up` makes (:data:`SUPPORTED_KIND`), so selecting an engine by
+problem kind never picks arrange-up for a problem it would refuse. Problems read by
+``PDDLReader`` from arrange-up's domain have a generic numeric kind shared by many problems
+arrange-up cannot read: the engines answer them when chosen by name (unified-planning then
+warns that the kind alone does not tell). unified-planning's meta engines (``replanner``,
+``oversubscription``) therefore no longer wrap arrange-up: they hand the engine problems they
+edited, which :func:`~arrange_up.up.compile.from_up` refuses. The planner and the repairer are
+satisficing (``satisfies(OptimalityGuarantee.SATISFICING)``), never optimal. Every engine has
+credits (``get_credits``), which unified-planning prints when it makes the engine
+(``get_environment().credits_stream = None`` silences them).
 
 **Registration.** The classes are found by unified-planning's factory through their module and
 class names (:data:`arrange_up.up.registration.ENGINES`); ``import arrange_up`` registers them
 without importing this module or unified-planning (:mod:`arrange_up.up.registration`).
-:func:`register` is re-exported here for existing callers.
+:func:`register` is re-exported here for existing callers. Programs that never import
+``arrange_up`` (unified-planning's ``up`` command) find the engines through a configuration
+file: ``python -m arrange_up.up`` prints it, ``python -m arrange_up.up --install`` adds it to the
+environment's ``up.ini`` (:mod:`arrange_up.up.__main__`).
 """
 
 from __future__ import annotations
