@@ -89,7 +89,7 @@ import difflib
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import IO, Any
 
 from unified_planning.engines import (
@@ -235,28 +235,47 @@ class _ArrangeUpEngine(Engine):
         )
 
 
-def _read_problem(problem: AbstractProblem) -> ArrangementProblem | tuple[bool, str]:
-    """The arrange-up problem of a unified-planning ``problem``, or ``(internal, message)``:
-    why it is not one (``internal`` False: not an arrange-up problem; True: reading it failed,
-    an arrange-up bug). Engines answer with the message, they never raise."""
+@dataclass(frozen=True)
+class _Refusal:
+    """Why a problem or plan cannot be read: ``internal`` False when it is not arrange-up's,
+    True when reading it failed (an arrange-up defect). Engines answer with the message, they
+    never raise."""
+
+    message: str
+    internal: bool = False
+
+
+def _read_problem(problem: AbstractProblem) -> ArrangementProblem | _Refusal:
+    """The arrange-up problem of a unified-planning ``problem``, or why there is none."""
     try:
         return from_up(problem)
     except ValueError as error:  # ProblemFormatError is a ValueError
-        return False, f"not an arrange-up problem: {error}"
+        return _Refusal(f"not an arrange-up problem: {error}")
     except Exception as error:  # from_up refuses foreign problems with ValueError; anything
         # else is a defect of the reader, reported as such rather than raised
-        return True, f"reading the problem failed: {type(error).__name__}: {error}"
+        return _Refusal(f"reading the problem failed: {type(error).__name__}: {error}", True)
 
 
-def _nominal_shortfall(problem: ArrangementProblem, actions: Sequence[Action]) -> str | None:
+def _nominal_shortfall(
+    problem: ArrangementProblem, actions: Sequence[Action]
+) -> str | _Refusal | None:
     """Why ``actions`` do not reach ``problem``'s goal in the deterministic semantics (the
-    nominal planner's transition: no noise, nominal initial poses), or ``None`` when they do.
+    nominal planner's transition: no noise, nominal initial poses), ``None`` when they do, or a
+    :class:`_Refusal` when the replay itself failed.
 
     The replay applies the symbolic preconditions of :func:`arrange_up.up.compile.to_up`'s
     actions (place an off-table part or fixture, push with an off-table manipulator, pick an
     on-table object), then each action's deterministic outcome
     (:class:`~arrange_up.transitions.particles.DeterministicSemantics`), then the planner's goal
     test (:class:`~arrange_up.belief.goals.GoalTest`)."""
+    try:
+        return _replay_shortfall(problem, actions)
+    except Exception as error:  # the engines answer, they never raise
+        message = f"the nominal replay failed: {type(error).__name__}: {error}"
+        return _Refusal(message, internal=True)
+
+
+def _replay_shortfall(problem: ArrangementProblem, actions: Sequence[Action]) -> str | None:
     kinds = {spec.name: spec.kind for spec in problem.objects}
     model = DeterministicSemantics(problem)
     try:
@@ -397,10 +416,9 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
             )
 
         arrangement = _read_problem(problem)
-        if isinstance(arrangement, tuple):
-            internal, message = arrangement
-            status = Status.INTERNAL_ERROR if internal else Status.UNSUPPORTED_PROBLEM
-            return result(status, logs=[LogMessage(LogLevel.ERROR, message)])
+        if isinstance(arrangement, _Refusal):
+            status = Status.INTERNAL_ERROR if arrangement.internal else Status.UNSUPPORTED_PROBLEM
+            return result(status, logs=[LogMessage(LogLevel.ERROR, arrangement.message)])
 
         deadline = None if timeout is None else started + max(0.0, float(timeout))
 
@@ -524,19 +542,18 @@ def _short(value: Any) -> str:
 
 def _read_problem_and_plan(
     problem: AbstractProblem, plan: Plan
-) -> tuple[ArrangementProblem, tuple[Action, ...]] | tuple[bool, str]:
+) -> tuple[ArrangementProblem, tuple[Action, ...]] | _Refusal:
     """The arrange-up problem and action list of a unified-planning ``problem`` and ``plan``,
-    or ``(internal, message)`` as :func:`_read_problem` (the validator and the repairer answer
-    with it; engines never raise)."""
+    or why not (the validator and the repairer answer with it; engines never raise)."""
     arrangement = _read_problem(problem)
-    if isinstance(arrangement, tuple):
+    if isinstance(arrangement, _Refusal):
         return arrangement
     try:
         actions = plan_from_up(plan)
     except ValueError as error:
-        return False, f"not a sequential plan of place/push/pick actions: {error}"
+        return _Refusal(f"not a sequential plan of place/push/pick actions: {error}")
     except Exception as error:  # plan_from_up refuses foreign plans with ValueError
-        return True, f"reading the plan failed: {type(error).__name__}: {error}"
+        return _Refusal(f"reading the plan failed: {type(error).__name__}: {error}", True)
     return arrangement, actions
 
 
@@ -600,9 +617,9 @@ class ArrangeUpReliability(_ArrangeUpEngine, PlanValidatorMixin):
             )
 
         read = _read_problem_and_plan(problem, plan)
-        if isinstance(read[0], bool):
-            return unknown(read[1])  # type: ignore[arg-type]
-        arrangement, actions = read  # type: ignore[misc]
+        if isinstance(read, _Refusal):
+            return unknown(read.message)
+        arrangement, actions = read
         deadline = None if self._timeout is None else started + self._timeout
         seen: list[EvaluationProgress] = []
 
@@ -794,13 +811,13 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
             return result(status, logs=[LogMessage(LogLevel.ERROR, message)])
 
         read = _read_problem_and_plan(problem, plan)
-        if isinstance(read[0], bool):
-            internal, message = read
-            return refuse(
-                message, Status.INTERNAL_ERROR if internal else Status.UNSUPPORTED_PROBLEM
-            )  # type: ignore[arg-type]
-        arrangement, nominal = read  # type: ignore[misc]
+        if isinstance(read, _Refusal):
+            status = Status.INTERNAL_ERROR if read.internal else Status.UNSUPPORTED_PROBLEM
+            return refuse(read.message, status)
+        arrangement, nominal = read
         shortfall = _nominal_shortfall(arrangement, nominal)
+        if isinstance(shortfall, _Refusal):
+            return refuse(shortfall.message, Status.INTERNAL_ERROR)
         if shortfall is not None:
             return refuse(
                 f"the plan is not a nominal plan of {arrangement.name!r}, so there is nothing "
@@ -865,6 +882,8 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
         repaired, logs = _plan_to_up(problem, arrangement, outcome.actions)
         # the plan handed out, as exact decimals, must reach the goal nominally: check it
         shortfall = _nominal_shortfall(arrangement, plan_from_up(repaired))
+        if isinstance(shortfall, _Refusal):
+            return refuse(shortfall.message, Status.INTERNAL_ERROR)
         if shortfall is not None:
             metrics["status"] = "missed-goal"
             message = (
