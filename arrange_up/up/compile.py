@@ -51,6 +51,7 @@ from typing import Any
 
 import unified_planning.model as m
 from unified_planning.environment import get_environment
+from unified_planning.model.problem_kind_versioning import LATEST_PROBLEM_KIND_VERSION
 from unified_planning.plans import ActionInstance, SequentialPlan
 
 from arrange_up.belief.states import AngleFrame
@@ -71,6 +72,8 @@ __all__ = [
     "ACTION_NAMES",
     "FLUENT_NAMES",
     "NOMINAL_SEMANTICS",
+    "READABLE_KIND",
+    "TO_UP_KIND",
     "TYPE_NAMES",
     "from_up",
     "made_by_to_up",
@@ -82,6 +85,32 @@ __all__ = [
 TYPE_NAMES = ("movable", "placeable", "part", "fixture", "manipulator", "obstacle")
 FLUENT_NAMES = ("on_table", "x", "y", "theta", "rel_x", "rel_y", "rel_theta")
 ACTION_NAMES = ("place", "push", "pick")
+
+
+def _kind(*extra: tuple[str, str]) -> m.ProblemKind:
+    kind = m.ProblemKind(version=LATEST_PROBLEM_KIND_VERSION)
+    kind.set_problem_class("ACTION_BASED")
+    kind.set_problem_type("SIMPLE_NUMERIC_PLANNING")
+    kind.set_typing("FLAT_TYPING")
+    kind.set_typing("HIERARCHICAL_TYPING")
+    kind.set_conditions_kind("NEGATIVE_CONDITIONS")
+    kind.set_parameters("REAL_ACTION_PARAMETERS")
+    kind.set_fluents_type("REAL_FLUENTS")
+    kind.set_simulated_entities("SIMULATED_EFFECTS")
+    for setter, feature in extra:
+        getattr(kind, setter)(feature)
+    return kind
+
+
+#: The problem kind of every problem :func:`to_up` makes (the same for every arrange-up problem:
+#: ``tests/up/test_engines.py`` checks it for each shipped domain).
+TO_UP_KIND = _kind()
+#: The widest kind :func:`from_up` can read: :data:`TO_UP_KIND`, and below it what ``PDDLReader``
+#: makes of arrange-up's PDDL domain (no real parameters, no simulated effects, numeric
+#: fluents whose initial value may be undefined). A problem with any other feature (integer or
+#: object fluents, durative actions, scheduling, hierarchies, ...) is not an arrange-up problem.
+READABLE_KIND = _kind(("set_initial_state", "UNDEFINED_INITIAL_NUMERIC"))
+
 _KIND_TYPE = {
     ObjectKind.PART: "part",
     ObjectKind.FIXTURE: "fixture",
@@ -277,9 +306,14 @@ def from_up(up_problem: Any) -> ArrangementProblem:
       :class:`~arrange_up.model.errors.ProblemFormatError` (a ``ValueError``) when it does not fit
       the vocabulary. Names are as UP read them: lowercase, since PDDL is case-insensitive
       (:func:`arrange_up.io.pddl.load_pddl_problem` restores the written case from the file).
+    * Anything else, refused with ``ValueError`` before any reading: a problem that is not a
+      plain UP ``Problem`` (scheduling, hierarchical, multi-agent, contingent, ...) or has a
+      feature outside :data:`READABLE_KIND`.
     """
     effect = _effect_of(up_problem)
-    if effect is not None:
+    if effect is None:
+        _check_readable(up_problem)
+    else:
         if effect.fingerprint != _fingerprint(up_problem):
             raise ValueError(
                 f"unified-planning problem {up_problem.name!r} was made by "
@@ -289,6 +323,24 @@ def from_up(up_problem: Any) -> ArrangementProblem:
             )
         return effect.problem
     return problem_from_up(up_problem)
+
+
+def _check_readable(up_problem: Any) -> None:
+    """Raise ``ValueError`` unless ``up_problem`` is a plain UP ``Problem`` whose kind is within
+    :data:`READABLE_KIND`: the PDDL vocabulary reader assumes both (numeric initial values,
+    object parameters, goals)."""
+    if not isinstance(up_problem, m.Problem) or type(up_problem) is not m.Problem:
+        raise ValueError(
+            f"a unified-planning {type(up_problem).__name__} is not an arrange-up problem: "
+            "expected a Problem made by arrange_up.up.compile.to_up or read by PDDLReader from "
+            "arrange-up's PDDL domain"
+        )
+    outside = sorted(set(up_problem.kind.features) - set(READABLE_KIND.features))
+    if outside:
+        raise ValueError(
+            f"problem {up_problem.name!r} has features no arrange-up problem has: "
+            f"{', '.join(outside)}"
+        )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -316,11 +368,32 @@ def plan_to_up(up_problem: Any, actions: Sequence[Action]) -> Any:
 
 def plan_from_up(plan: Any) -> tuple[Action, ...]:
     """The arrange-up actions (inches, radians) of a UP ``SequentialPlan`` over the model of
-    :func:`to_up`."""
+    :func:`to_up`.
+
+    Raises ``ValueError`` for another kind of plan, or an action that is not ``place``,
+    ``push`` or ``pick`` with the parameters :func:`to_up` gives them (an object, then
+    numbers)."""
+    if not isinstance(plan, SequentialPlan):
+        raise ValueError(
+            f"a {type(plan).__name__} is not a sequential plan; expected a SequentialPlan of "
+            "place/push/pick actions"
+        )
     out: list[Action] = []
-    for instance in plan.actions:
+    for k, instance in enumerate(plan.actions):
         name = instance.action.name
         params = instance.actual_parameters
+        arity = _ARITY.get(name)
+        if arity is None:
+            raise ValueError(f"action {k + 1}, {name!r}, is not place, push or pick")
+        if (
+            len(params) != arity
+            or not params[0].is_object_exp()
+            or not all(p.is_int_constant() or p.is_real_constant() for p in params[1:])
+        ):
+            raise ValueError(
+                f"action {k + 1}, {instance}, does not have the parameters of arrange-up's "
+                f"{name} (an object, then {arity - 1} numbers)"
+            )
         if name == "pick":
             out.append(Pick(params[0].object().name))
             continue
@@ -328,11 +401,13 @@ def plan_from_up(plan: Any) -> tuple[Action, ...]:
         pose = (x, y, math.radians(theta))
         if name == "place":
             out.append(Place(params[0].object().name, pose))
-        elif name == "push":
-            out.append(Push(params[0].object().name, pose, float(params[4].constant_value())))
         else:
-            raise ValueError(f"action {name!r} is not place, push or pick")
+            out.append(Push(params[0].object().name, pose, float(params[4].constant_value())))
     return tuple(out)
+
+
+#: The number of parameters of each action of :func:`to_up`'s model.
+_ARITY = {"place": 4, "push": 5, "pick": 1}
 
 
 def _pose_params(em: Any, pose: Sequence[float]) -> list[Any]:

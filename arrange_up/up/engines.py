@@ -26,7 +26,7 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
 * ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
   watches the clock itself.
 * ``UNSUPPORTED_PROBLEM``: the problem is not an arrange-up problem; ``INTERNAL_ERROR``: the
-  planner failed. Both with a log message saying why.
+  planner failed, or reading the problem did. Both with a log message saying why.
 
 Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` (default
 ``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000).
@@ -41,7 +41,10 @@ that failed most often), ``UNKNOWN`` when the problem or the plan cannot be conv
 evaluation fails. Metrics: ``successes``, ``trials``, ``rate``, ``interval`` (the 95% Wilson
 interval as ``[low, high]``), ``interval_low``, ``interval_high``, ``seed``, ``elapsed`` and the
 failure counts per kind. Parameters: ``rollouts`` (1000), ``seed`` (0), ``workers`` (``None``:
-all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address).
+all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask scheduler address),
+``timeout`` (seconds, ``None``: none). unified-planning's ``validate`` takes no timeout, so it
+is a parameter; it is checked as rollouts finish, and when it runs out the answer is ``UNKNOWN``
+with a log message saying how many rollouts were done.
 
     >>> from unified_planning.shortcuts import PlanValidator
     >>> with PlanValidator(name="arrange-up-reliability", params={"rollouts": 100}) as v:
@@ -49,23 +52,48 @@ all cores), ``backend`` (``"local"`` or ``"dask"``), ``scheduler`` (a Dask sched
     >>> check.metrics["successes"], check.metrics["interval"]     # doctest: +SKIP
     ('100', '[0.963, 1]')
 
-**The repairer** (:class:`ArrangeUpFixtureRepairer`): see its docstring.
+**The repairer** (:class:`ArrangeUpFixtureRepairer`): see its docstring. It answers
+``SOLVED_SATISFICING`` only with a plan that reaches the goal in the deterministic semantics.
+
+**Every engine answers, none raises** on any problem or plan unified-planning can build: a
+problem that is not an arrange-up one is refused with a status (``UNSUPPORTED_PROBLEM``;
+``UNKNOWN`` from the validator) and a log message, a failure inside arrange-up is reported as
+``INTERNAL_ERROR`` (``UNKNOWN``) with the exception named. Only the parameters are checked when
+the engine is made: a bad value raises ``ValueError``, an unknown name ``TypeError`` naming the
+accepted ones.
+
+**Kinds and guarantees.** ``supports(kind)`` is true for exactly the kind of the problems
+:func:`~arrange_up.up.compile.to_up` makes (:data:`SUPPORTED_KIND`), so selecting an engine by
+problem kind never picks arrange-up for a problem it would refuse. Problems read by
+``PDDLReader`` from arrange-up's domain have a generic numeric kind shared by many problems
+arrange-up cannot read: the engines answer them when chosen by name (unified-planning then
+warns that the kind alone does not tell). unified-planning's meta engines (``replanner``,
+``oversubscription``) therefore no longer wrap arrange-up: they hand the engine problems they
+edited, which :func:`~arrange_up.up.compile.from_up` refuses. The planner and the repairer are
+satisficing (``satisfies(OptimalityGuarantee.SATISFICING)``), never optimal. Every engine has
+credits (``get_credits``), which unified-planning prints when it makes the engine
+(``get_environment().credits_stream = None`` silences them).
 
 **Registration.** The classes are found by unified-planning's factory through their module and
 class names (:data:`arrange_up.up.registration.ENGINES`); ``import arrange_up`` registers them
 without importing this module or unified-planning (:mod:`arrange_up.up.registration`).
-:func:`register` is re-exported here for existing callers.
+:func:`register` is re-exported here for existing callers. Programs that never import
+``arrange_up`` (unified-planning's ``up`` command) find the engines through a configuration
+file: ``python -m arrange_up.up`` prints it, ``python -m arrange_up.up --install`` adds it to the
+environment's ``up.ini`` (:mod:`arrange_up.up.__main__`).
 """
 
 from __future__ import annotations
 
+import difflib
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import IO, Any
 
 from unified_planning.engines import (
+    Credits,
     Engine,
     LogLevel,
     LogMessage,
@@ -78,18 +106,28 @@ from unified_planning.engines.mixins import (
     PlanRepairerMixin,
     PlanValidatorMixin,
 )
+from unified_planning.engines.mixins.oneshot_planner import OptimalityGuarantee
 from unified_planning.engines.results import FailedValidationReason, ValidationResultStatus
 from unified_planning.model import AbstractProblem, ProblemKind
 from unified_planning.model.state import State
 from unified_planning.plans import Plan, PlanKind
 
-from arrange_up.evaluation.evaluate import GOAL_MISSED, evaluate_plan
-from arrange_up.model.problem import ArrangementProblem
-from arrange_up.model.world import Action, Push
+from arrange_up.belief.goals import GoalTest
+from arrange_up.evaluation.evaluate import GOAL_MISSED, EvaluationProgress, evaluate_plan
+from arrange_up.model.problem import ArrangementProblem, ObjectKind
+from arrange_up.model.world import Action, Place, Push
 from arrange_up.planning import planner
-from arrange_up.repair.fixture_repair import repair_plan
+from arrange_up.repair.fixture_repair import TIMEOUT, repair_plan
 from arrange_up.transitions import available
-from arrange_up.up.compile import from_up, made_by_to_up, plan_from_up, plan_to_up, to_up
+from arrange_up.transitions.particles import DeterministicSemantics
+from arrange_up.up.compile import (
+    TO_UP_KIND,
+    from_up,
+    made_by_to_up,
+    plan_from_up,
+    plan_to_up,
+    to_up,
+)
 from arrange_up.up.registration import (
     ENGINE_CLASS,
     ENGINE_NAME,
@@ -116,34 +154,58 @@ __all__ = [
 ]
 
 
-def _supported_kind() -> ProblemKind:
-    kind = ProblemKind(version=2)
-    kind.set_problem_class("ACTION_BASED")
-    kind.set_problem_type("SIMPLE_NUMERIC_PLANNING")
-    kind.set_typing("FLAT_TYPING")
-    kind.set_typing("HIERARCHICAL_TYPING")
-    kind.set_conditions_kind("NEGATIVE_CONDITIONS")
-    kind.set_conditions_kind("EQUALITIES")
-    kind.set_parameters("REAL_ACTION_PARAMETERS")
-    kind.set_fluents_type("REAL_FLUENTS")
-    kind.set_simulated_entities("SIMULATED_EFFECTS")
-    kind.set_initial_state("UNDEFINED_INITIAL_NUMERIC")
-    return kind
+#: The problem kind every arrange-up engine supports: exactly the kind of what ``to_up`` makes.
+#: Problems read by ``PDDLReader`` from arrange-up's domain are of a generic numeric kind that
+#: many problems arrange-up cannot read share, so they are not offered by kind; the engines
+#: still answer them when chosen by name (unified-planning then warns that the kind alone does
+#: not tell).
+SUPPORTED_KIND = TO_UP_KIND
 
-
-#: The problem kind every arrange-up engine supports: the kind of what ``to_up`` makes.
-SUPPORTED_KIND = _supported_kind()
+#: Credits unified-planning prints when it makes one of the engines (``get_credits``).
+_CREDITS = {
+    "author": "arrange-up developers",
+    "contact": "the arrange-up developers (see the package's README)",
+    "website": "none published; see the README of the arrange-up package",
+    "license": "MIT",
+}
+_DESCRIPTIONS = {
+    ENGINE_NAME: (
+        "Conformant belief-space planning for tabletop place/push/pick problems.",
+        "Conformant belief-space A* for robot tabletop manipulation: plans place, push and pick "
+        "actions whose outcome is simulated with rigid-body physics (pymunk), over particle or "
+        "interval beliefs of the uncertain initial poses and action noise.",
+    ),
+    VALIDATOR_NAME: (
+        "Monte Carlo reliability of place/push/pick plans under the problem's noise.",
+        "Validates a place/push/pick plan by Monte Carlo rollouts under the problem's full "
+        "noise; VALID only when every rollout reaches the goal, with the 95% Wilson interval of "
+        "the success rate.",
+    ),
+    REPAIRER_NAME: (
+        "Fixture-placement repair of nominal place/push/pick plans.",
+        "Makes a nominal plan robust by placing fixtures that guide each push (plan repair with "
+        "fixtures), choosing placements and push distances on a particle belief.",
+    ),
+}
 
 
 class _ArrangeUpEngine(Engine):
     """The shared base of arrange-up's engines: the engine's name from the class attribute
-    ``_NAME``, and the problem kinds and plan kinds every arrange-up engine supports."""
+    ``_NAME``, credits, the parameter names it accepts (``_PARAMETERS``), and the problem kinds
+    and plan kinds every arrange-up engine supports."""
 
     _NAME = ""
+    #: The names of the engine's parameters (``params={...}``), as its ``__init__`` takes them.
+    _PARAMETERS: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
         return self._NAME
+
+    @classmethod
+    def get_credits(cls, **kwargs: Any) -> Credits | None:
+        short, long = _DESCRIPTIONS[cls._NAME]
+        return Credits(name=cls._NAME, short_description=short, long_description=long, **_CREDITS)
 
     @staticmethod
     def supported_kind() -> ProblemKind:
@@ -151,11 +213,128 @@ class _ArrangeUpEngine(Engine):
 
     @staticmethod
     def supports(problem_kind: ProblemKind) -> bool:
-        return bool(problem_kind <= SUPPORTED_KIND)
+        return bool(problem_kind <= SUPPORTED_KIND and SUPPORTED_KIND <= problem_kind)
 
     @staticmethod
     def supports_plan(plan_kind: PlanKind) -> bool:
         return bool(plan_kind == PlanKind.SEQUENTIAL_PLAN)
+
+    @classmethod
+    def _refuse_unknown(cls, unknown: dict[str, Any]) -> None:
+        """Raise ``TypeError`` naming the unknown parameters, close matches and the accepted
+        parameters (a bare ``__init__() got an unexpected keyword`` names none of them)."""
+        if not unknown:
+            return
+        parts = []
+        for name in sorted(unknown):
+            close = difflib.get_close_matches(name, cls._PARAMETERS, n=1)
+            parts.append(f"{name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+        raise TypeError(
+            f"{cls._NAME}: unknown parameter{'s' if len(parts) > 1 else ''} "
+            f"{', '.join(parts)}; the accepted parameters are {', '.join(cls._PARAMETERS)}"
+        )
+
+
+@dataclass(frozen=True)
+class _Refusal:
+    """Why a problem or plan cannot be read: ``internal`` False when it is not arrange-up's,
+    True when reading it failed (an arrange-up defect). Engines answer with the message, they
+    never raise."""
+
+    message: str
+    internal: bool = False
+
+
+def _read_problem(problem: AbstractProblem) -> ArrangementProblem | _Refusal:
+    """The arrange-up problem of a unified-planning ``problem``, or why there is none."""
+    try:
+        return from_up(problem)
+    except ValueError as error:  # ProblemFormatError is a ValueError
+        return _Refusal(f"not an arrange-up problem: {error}")
+    except Exception as error:  # from_up refuses foreign problems with ValueError; anything
+        # else is a defect of the reader, reported as such rather than raised
+        return _Refusal(f"reading the problem failed: {type(error).__name__}: {error}", True)
+
+
+def _nominal_shortfall(
+    problem: ArrangementProblem, actions: Sequence[Action]
+) -> str | _Refusal | None:
+    """Why ``actions`` do not reach ``problem``'s goal in the deterministic semantics (the
+    nominal planner's transition: no noise, nominal initial poses), ``None`` when they do, or a
+    :class:`_Refusal` when the replay itself failed.
+
+    The replay applies the symbolic preconditions of :func:`arrange_up.up.compile.to_up`'s
+    actions (place an off-table part or fixture, push with an off-table manipulator, pick an
+    on-table object), then each action's deterministic outcome
+    (:class:`~arrange_up.transitions.particles.DeterministicSemantics`), then the planner's goal
+    test (:class:`~arrange_up.belief.goals.GoalTest`)."""
+    try:
+        return _replay_shortfall(problem, actions)
+    except Exception as error:  # the engines answer, they never raise
+        message = f"the nominal replay failed: {type(error).__name__}: {error}"
+        return _Refusal(message, internal=True)
+
+
+def _replay_shortfall(problem: ArrangementProblem, actions: Sequence[Action]) -> str | None:
+    kinds = {spec.name: spec.kind for spec in problem.objects}
+    model = DeterministicSemantics(problem)
+    try:
+        belief = model.initial_belief()
+        for k, action in enumerate(actions):
+            on_table = belief.particles[0].names()
+            refusal = _precondition_failure(action, kinds, on_table)
+            if refusal:
+                return f"action {k + 1} ({_describe(action)}) {refusal}"
+            after = model.apply(belief, action)
+            if after is None:
+                return (
+                    f"action {k + 1} ({_describe(action)}) fails: an object leaves the table or "
+                    "never comes to rest"
+                )
+            belief = after
+    finally:
+        model.close()
+    misses = GoalTest(problem).misses(belief.particles[0])
+    if not misses:
+        return None
+    where = "; ".join(
+        f"{miss.part} {', '.join(miss.dimensions())}"
+        + (
+            ""
+            if miss.missing
+            else " (by " + ", ".join(f"{e:.4g}" for e in miss.excess if e > 0) + ")"
+        )
+        for miss in misses
+    )
+    return f"after its {len(actions)} action(s) the goal is not reached: {where}"
+
+
+def _precondition_failure(
+    action: Action, kinds: dict[str, ObjectKind], on_table: Sequence[str]
+) -> str | None:
+    name = action.manipulator if isinstance(action, Push) else action.obj
+    kind = kinds.get(name)
+    if kind is None:
+        return f"names {name!r}, which is not an object of the problem"
+    if isinstance(action, Place):
+        if kind not in (ObjectKind.PART, ObjectKind.FIXTURE):
+            return f"places {name}, a {kind.value}: only parts and fixtures are placed"
+        if name in on_table:
+            return f"places {name}, which is already on the table"
+    elif isinstance(action, Push):
+        if kind is not ObjectKind.MANIPULATOR:
+            return f"pushes with {name}, a {kind.value}, not a manipulator"
+        if name in on_table:
+            return f"pushes with {name}, which is on the table"
+    elif kind is ObjectKind.OBSTACLE or name not in on_table:
+        return f"picks {name}, which is not a movable object on the table"
+    return None
+
+
+def _describe(action: Action) -> str:
+    if isinstance(action, Push):
+        return f"push with {action.manipulator}"
+    return f"{type(action).__name__.lower()} {action.obj}"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -165,6 +344,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
     """Conformant belief-space planning for arrange-up problems (see the module doc)."""
 
     _NAME = ENGINE_NAME
+    _PARAMETERS = ("semantics", "particles", "seed", "max_nodes")
 
     def __init__(
         self,
@@ -172,7 +352,9 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
         particles: int = 50,
         seed: int = 0,
         max_nodes: int | None = None,
+        **unknown: Any,
     ) -> None:
+        self._refuse_unknown(unknown)
         Engine.__init__(self)
         OneshotPlannerMixin.__init__(self)
         _check_params(semantics, particles, seed, max_nodes)
@@ -180,6 +362,11 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
         self._particles = particles
         self._seed = seed
         self._max_nodes = max_nodes
+
+    @staticmethod
+    def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
+        """Satisficing only: the plans are not claimed optimal (weighted A*, incomplete)."""
+        return optimality_guarantee is OptimalityGuarantee.SATISFICING
 
     def _solve_with_params(
         self,
@@ -228,13 +415,10 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
                 status, plan, ENGINE_NAME, metrics=metrics, log_messages=list(logs) or None
             )
 
-        try:
-            arrangement = from_up(problem)
-        except ValueError as error:  # ProblemFormatError is a ValueError
-            return result(
-                Status.UNSUPPORTED_PROBLEM,
-                logs=[LogMessage(LogLevel.ERROR, f"not an arrange-up problem: {error}")],
-            )
+        arrangement = _read_problem(problem)
+        if isinstance(arrangement, _Refusal):
+            status = Status.INTERNAL_ERROR if arrangement.internal else Status.UNSUPPORTED_PROBLEM
+            return result(status, logs=[LogMessage(LogLevel.ERROR, arrangement.message)])
 
         deadline = None if timeout is None else started + max(0.0, float(timeout))
 
@@ -358,19 +542,30 @@ def _short(value: Any) -> str:
 
 def _read_problem_and_plan(
     problem: AbstractProblem, plan: Plan
-) -> tuple[ArrangementProblem, tuple[Action, ...]] | str:
+) -> tuple[ArrangementProblem, tuple[Action, ...]] | _Refusal:
     """The arrange-up problem and action list of a unified-planning ``problem`` and ``plan``,
-    or the message that says which of the two is not one (the validator and the repairer
-    answer with it; engines never raise)."""
-    try:
-        arrangement = from_up(problem)
-    except ValueError as error:  # ProblemFormatError is a ValueError
-        return f"not an arrange-up problem: {error}"
+    or why not (the validator and the repairer answer with it; engines never raise)."""
+    arrangement = _read_problem(problem)
+    if isinstance(arrangement, _Refusal):
+        return arrangement
     try:
         actions = plan_from_up(plan)
-    except (AttributeError, TypeError, ValueError) as error:
-        return f"not a sequential plan of place/push/pick actions: {error}"
+    except ValueError as error:
+        return _Refusal(f"not a sequential plan of place/push/pick actions: {error}")
+    except Exception as error:  # plan_from_up refuses foreign plans with ValueError
+        return _Refusal(f"reading the plan failed: {type(error).__name__}: {error}", True)
     return arrangement, actions
+
+
+def _check_timeout(engine: str, timeout: Any) -> None:
+    if timeout is not None and (
+        isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0
+    ):
+        raise ValueError(f"{engine}: timeout must be a positive number of seconds, got {timeout!r}")
+
+
+class _OutOfTime(Exception):
+    """Raised from an evaluation's progress callback when the validator's timeout ran out."""
 
 
 def _positive(value: Any) -> bool:
@@ -384,6 +579,7 @@ class ArrangeUpReliability(_ArrangeUpEngine, PlanValidatorMixin):
     """Monte Carlo reliability of a plan under the problem's noise (see the module doc)."""
 
     _NAME = VALIDATOR_NAME
+    _PARAMETERS = ("rollouts", "seed", "workers", "backend", "scheduler", "timeout")
 
     def __init__(
         self,
@@ -392,28 +588,46 @@ class ArrangeUpReliability(_ArrangeUpEngine, PlanValidatorMixin):
         workers: int | None = None,
         backend: str = "local",
         scheduler: str | None = None,
+        timeout: float | None = None,
+        **unknown: Any,
     ) -> None:
+        self._refuse_unknown(unknown)
         Engine.__init__(self)
         PlanValidatorMixin.__init__(self)
         _check_validator_params(rollouts, seed, workers, backend, scheduler)
+        _check_timeout(VALIDATOR_NAME, timeout)
         self._rollouts = rollouts
         self._seed = seed
         self._workers = workers
         self._backend = backend
         self._scheduler = scheduler
+        self._timeout = timeout
 
     def _validate(self, problem: AbstractProblem, plan: Plan) -> ValidationResult:
-        def unknown(message: str) -> ValidationResult:
+        started = time.monotonic()
+
+        def unknown(
+            message: str, level: LogLevel = LogLevel.ERROR, metrics: dict[str, str] | None = None
+        ) -> ValidationResult:
             return ValidationResult(
                 ValidationResultStatus.UNKNOWN,
                 VALIDATOR_NAME,
-                log_messages=[LogMessage(LogLevel.ERROR, message)],
+                log_messages=[LogMessage(level, message)],
+                metrics=metrics,
             )
 
         read = _read_problem_and_plan(problem, plan)
-        if isinstance(read, str):
-            return unknown(read)
+        if isinstance(read, _Refusal):
+            return unknown(read.message)
         arrangement, actions = read
+        deadline = None if self._timeout is None else started + self._timeout
+        seen: list[EvaluationProgress] = []
+
+        def watch(progress: EvaluationProgress) -> None:
+            seen[:] = [progress]
+            if deadline is not None and time.monotonic() >= deadline:
+                raise _OutOfTime
+
         try:
             outcome = evaluate_plan(
                 arrangement,
@@ -423,7 +637,21 @@ class ArrangeUpReliability(_ArrangeUpEngine, PlanValidatorMixin):
                 workers=self._workers,
                 backend=self._backend,
                 scheduler=self._scheduler,
+                progress=watch,
             )
+        except _OutOfTime:
+            done = seen[0].done if seen else 0
+            successes = seen[0].successes if seen else 0
+            message = (
+                f"timeout of {self._timeout} s reached after {done} of {self._rollouts} "
+                f"rollouts ({successes} reached the goal): no verdict"
+            )
+            metrics = {
+                "done": str(done),
+                "successes": str(successes),
+                "rollouts": str(self._rollouts),
+            }
+            return unknown(message, LogLevel.INFO, metrics)
         except Exception as error:  # the engine must answer, not raise
             return unknown(f"the evaluation failed: {type(error).__name__}: {error}")
 
@@ -515,18 +743,29 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
     ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
 
     Parameters: ``particles`` (150), ``seed`` (0), ``method`` (``"enhanced"`` or
-    ``"naive"``), ``workers`` (1). The plan is the nominal plan to repair (a
-    ``SequentialPlan`` of place/push/pick); the result is a ``PlanGenerationResult``:
-    ``SOLVED_SATISFICING`` with the repaired plan, ``UNSOLVABLE_INCOMPLETELY`` when a step
-    could not be repaired (the log message says which and why; the repair is greedy, so
-    nothing is proven), ``UNSUPPORTED_PROBLEM`` when the problem or plan is not
-    arrange-up's (or the plan fails in the deterministic semantics), ``INTERNAL_ERROR`` when
-    the repair raised. Metrics: ``status``, ``elapsed``, ``simulations``, ``pushes``,
-    ``fixtures_placed``, ``plan_length``, ``method``, ``particles``, ``seed`` and
-    ``step_K`` (the choice made for nominal step K).
+    ``"naive"``), ``workers`` (1), ``timeout`` (seconds, ``None``: none; unified-planning's
+    ``repair`` takes no timeout, so it is an engine parameter). The plan is the nominal plan to
+    repair (a ``SequentialPlan`` of place/push/pick) and must reach the goal in the
+    deterministic semantics: fixtures make a nominal plan robust, they do not complete one.
+    The result is a ``PlanGenerationResult``:
+
+    * ``SOLVED_SATISFICING`` with the repaired plan, which reaches the goal in the
+      deterministic semantics (replayed before answering);
+    * ``UNSOLVABLE_INCOMPLETELY`` when the given plan does not reach the goal nominally (an
+      action fails or is inapplicable, or the goal is missed: nothing is repaired), when a step
+      could not be repaired, or when the repaired plan misses the goal nominally; the log
+      message says which and why (the repair is greedy, so nothing is proven);
+    * ``TIMEOUT`` when ``timeout`` ran out (checked between batches of candidates);
+    * ``UNSUPPORTED_PROBLEM`` when the problem or the plan is not arrange-up's;
+    * ``INTERNAL_ERROR`` when the repair raised.
+
+    Metrics: ``status``, ``elapsed``, ``simulations``, ``pushes``, ``fixtures_placed``,
+    ``plan_length``, ``method``, ``particles``, ``seed`` and ``step_K`` (the choice made for
+    nominal step K).
     """
 
     _NAME = REPAIRER_NAME
+    _PARAMETERS = ("particles", "seed", "method", "workers", "timeout")
 
     def __init__(
         self,
@@ -534,16 +773,28 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
         seed: int = 0,
         method: str = "enhanced",
         workers: int = 1,
+        timeout: float | None = None,
+        **unknown: Any,
     ) -> None:
+        self._refuse_unknown(unknown)
         Engine.__init__(self)
         PlanRepairerMixin.__init__(self)
         _check_repairer_params(particles, seed, method, workers)
+        _check_timeout(REPAIRER_NAME, timeout)
         self._particles = particles
         self._seed = seed
         self._method = method
         self._workers = workers
+        self._timeout = timeout
+
+    @staticmethod
+    def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
+        """Satisficing only: the repaired plans are not claimed optimal."""
+        return optimality_guarantee is OptimalityGuarantee.SATISFICING
 
     def _repair(self, problem: AbstractProblem, plan: Plan) -> PlanGenerationResult:
+        started = time.monotonic()
+
         def result(
             status: Status,
             plan: Plan | None = None,
@@ -554,13 +805,31 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
                 status, plan, REPAIRER_NAME, metrics=metrics, log_messages=list(logs) or None
             )
 
-        def refuse(message: str) -> PlanGenerationResult:
-            return result(Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, message)])
+        def refuse(
+            message: str, status: Status = Status.UNSUPPORTED_PROBLEM
+        ) -> PlanGenerationResult:
+            return result(status, logs=[LogMessage(LogLevel.ERROR, message)])
 
         read = _read_problem_and_plan(problem, plan)
-        if isinstance(read, str):
-            return refuse(read)
+        if isinstance(read, _Refusal):
+            status = Status.INTERNAL_ERROR if read.internal else Status.UNSUPPORTED_PROBLEM
+            return refuse(read.message, status)
         arrangement, nominal = read
+        shortfall = _nominal_shortfall(arrangement, nominal)
+        if isinstance(shortfall, _Refusal):
+            return refuse(shortfall.message, Status.INTERNAL_ERROR)
+        if shortfall is not None:
+            return refuse(
+                f"the plan is not a nominal plan of {arrangement.name!r}, so there is nothing "
+                f"to repair: {shortfall} in the deterministic semantics. {REPAIRER_NAME} makes a "
+                "plan that reaches the goal nominally robust with fixtures; it does not complete "
+                "plans (plan one with OneshotPlanner(name='arrange-up', params={'semantics': "
+                "'deterministic'}))",
+                Status.UNSOLVABLE_INCOMPLETELY,
+            )
+        remaining = None
+        if self._timeout is not None:
+            remaining = max(0.0, started + self._timeout - time.monotonic())
         try:
             outcome = repair_plan(
                 arrangement,
@@ -569,9 +838,10 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
                 seed=self._seed,
                 method=self._method,
                 workers=self._workers,
+                timeout=remaining,
             )
         except ValueError as error:
-            return refuse(f"the plan cannot be repaired: {error}")
+            return refuse(f"the plan cannot be repaired: {error}", Status.UNSOLVABLE_INCOMPLETELY)
         except Exception as error:  # the engine must answer, not raise
             return result(
                 Status.INTERNAL_ERROR,
@@ -599,6 +869,9 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
                     "no fixture" if record.pose is None else f"{record.fixture} at {record.pose}"
                 )
                 metrics[f"step_{record.index + 1}"] = f"{where}, x{record.multiplier:g}"
+        if outcome.status == TIMEOUT:
+            message = f"timeout of {self._timeout} s reached before the plan was repaired"
+            return result(Status.TIMEOUT, None, [LogMessage(LogLevel.INFO, message)], metrics)
         if not outcome.solved or outcome.actions is None:
             return result(
                 Status.UNSOLVABLE_INCOMPLETELY,
@@ -607,6 +880,19 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
                 metrics,
             )
         repaired, logs = _plan_to_up(problem, arrangement, outcome.actions)
+        # the plan handed out, as exact decimals, must reach the goal nominally: check it
+        shortfall = _nominal_shortfall(arrangement, plan_from_up(repaired))
+        if isinstance(shortfall, _Refusal):
+            return refuse(shortfall.message, Status.INTERNAL_ERROR)
+        if shortfall is not None:
+            metrics["status"] = "missed-goal"
+            message = (
+                f"the repair made a plan, but it does not reach the goal in the deterministic "
+                f"semantics: {shortfall}; no plan is returned"
+            )
+            return result(
+                Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
+            )
         return result(Status.SOLVED_SATISFICING, repaired, logs, metrics)
 
 

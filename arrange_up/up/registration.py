@@ -12,6 +12,10 @@ start-up cost dwarfs the rest of ``import arrange_up`` (figures and the commands
 them: ``docs/design/up.md``), so when unified-planning has not loaded its factory yet,
 registration waits for it with an import hook. That hook is the one piece of import-system
 machinery in the package, and it lives here.
+
+Programs that never import ``arrange_up``, such as unified-planning's own ``up`` command, can
+find the engines only through a unified-planning configuration file: :func:`up_ini` gives its
+sections, and ``python -m arrange_up.up`` prints or installs them (:mod:`arrange_up.up.__main__`).
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ __all__ = [
     "VALIDATOR_CLASS",
     "VALIDATOR_NAME",
     "register",
+    "up_ini",
 ]
 
 #: The module that defines the engine classes (it imports unified-planning).
@@ -74,6 +79,28 @@ def register(environment: Any = None) -> None:
         for name, module_name, class_name in ENGINES:
             if name not in environment.factory.engines:
                 environment.factory.add_engine(name, module_name, class_name)
+
+
+def up_ini() -> str:
+    """The ``[engine NAME]`` sections of a unified-planning configuration file (``up.ini``) that
+    name arrange-up's engines (:data:`ENGINES`), for programs that never import ``arrange_up``.
+
+    unified-planning 1.3 reads such a file from every parent directory of the running script
+    (``up.ini`` or ``.up.ini``) and from the home directory (``~/up.ini``, ``~/.up.ini``,
+    ``~/.uprc``), whenever it makes a factory; every section makes the factory import the
+    engine's module, so a file naming arrange-up breaks unified-planning wherever ``arrange_up``
+    is not installed."""
+    lines = [
+        "# arrange-up's unified-planning engines (python -m arrange_up.up prints these lines)",
+    ]
+    for name, module_name, class_name in ENGINES:
+        lines += [
+            "",
+            f"[engine {name}]",
+            f"module_name: {module_name}",
+            f"class_name: {class_name}",
+        ]
+    return "\n".join(lines) + "\n"
 
 
 def _add_to_defaults(factory_module: Any) -> None:

@@ -187,3 +187,14 @@ def test_actions_of_the_same_problem_from_yaml_and_pddl_are_equal():
 
     from_pddl = load_pddl_problem(domains_dir() / "blocks-1.pddl")
     assert to_up(from_pddl).action("place") == to_up(load("blocks-1")).action("place")
+
+
+def test_from_up_refuses_every_example_problem_of_unified_planning_with_value_error():
+    from unified_planning.test.examples import get_example_problems
+
+    for case in get_example_problems().values():
+        with pytest.raises(ValueError):  # ProblemFormatError included; never another error
+            from_up(case.problem)
+    scheduling = get_example_problems()["sched:basic"].problem
+    with pytest.raises(ValueError, match="a unified-planning SchedulingProblem is not an arrange"):
+        from_up(scheduling)
