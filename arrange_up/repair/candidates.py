@@ -21,6 +21,7 @@ import numpy as np
 
 from arrange_up.belief.states import IntervalBelief, ParticleBelief, symmetry_period
 from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
 
@@ -176,9 +177,7 @@ def clear_approach(
     far. Gives up at :data:`MAX_BACKOFF` (the push then keeps its pose and fails in the
     particles it lands on)."""
     spec = problem.object(push.manipulator)
-    px, py = spec.push_direction
-    c, s = math.cos(push.pose[2]), math.sin(push.pose[2])
-    ux, uy = c * px - s * py, s * px + c * py
+    ux, uy = rotate(spec.push_direction, push.pose[2])
     half = tuple(v + BACKOFF_GAP if k < 2 else v for k, v in enumerate(problem.uncertainty.push))
     others = [(name, iv.center, iv.half) for name, iv in intervals.objects]
     n = int(round(MAX_BACKOFF / BACKOFF_STEP))

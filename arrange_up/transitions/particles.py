@@ -50,6 +50,7 @@ from arrange_up.belief.states import (
 )
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import (
     Action,
@@ -200,9 +201,8 @@ class ParticleSemantics:
     def affected_objects(self, intervals: IntervalBelief, push: Push) -> frozenset[str]:
         """Objects the push may touch, directly or through others (a conservative sweep)."""
         spec = self.problem.object(push.manipulator)
-        px, py = spec.push_direction
-        c, s = np.cos(push.pose[2]), np.sin(push.pose[2])
-        direction = (round(c * px - s * py), round(s * px + c * py))
+        ux, uy = rotate(spec.push_direction, push.pose[2])
+        direction = (round(ux), round(uy))
         boxes = {
             name: self.checker.shadow_box(name, iv.center, iv.half)
             for name, iv in intervals.objects

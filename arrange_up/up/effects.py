@@ -43,6 +43,7 @@ from unified_planning.exceptions import UPInvalidActionError
 from unified_planning.model import SimulatedEffect
 
 from arrange_up.belief.states import ParticleBelief, symmetry_period, wrap_angle
+from arrange_up.geometry.se2 import relative
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action, Place, Push, WorldState
 from arrange_up.transitions import make_semantics
@@ -132,12 +133,11 @@ class PoseFluents:
             if ref is None or pose is None:
                 out[fx] = out[fy] = out[ftheta] = Fraction(0)
                 continue
-            dx, dy = pose[0] - ref[0], pose[1] - ref[1]
-            c, s = math.cos(ref[2]), math.sin(ref[2])
+            rx, ry, _ = relative(ref, pose)
             period = symmetry_period(problem.object(part).shape)
             theta = wrap_angle(pose[2] - ref[2], goal.target(part)[2], period)
-            out[fx] = exact(c * dx + s * dy)
-            out[fy] = exact(-s * dx + c * dy)
+            out[fx] = exact(rx)
+            out[fy] = exact(ry)
             out[ftheta] = exact_degrees(theta)
         return out
 
