@@ -25,6 +25,7 @@ from functools import cache, cached_property
 
 import numpy as np
 
+from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose, Shape
 from arrange_up.model.world import WorldState
 
@@ -225,8 +226,6 @@ def sample_initial_particles(
     Raises ``ValueError`` if a particle cannot be drawn in ``max_tries_per_particle`` tries
     (an initial belief that is almost all collisions).
     """
-    from arrange_up.geometry.collision import CollisionChecker
-
     checker = CollisionChecker(problem)
     frame = frame or AngleFrame.of(problem)
     states = []

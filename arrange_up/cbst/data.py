@@ -66,6 +66,11 @@ import numpy as np
 
 from arrange_up.cbst.contact_graph import MIN_OVERLAP, MIN_OVERLAP_PADDLE, PUSH_MARGIN
 from arrange_up.cbst.features import Domain, feature_row
+from arrange_up.geometry.shapes import shadow_box
+from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind, ObjectSpec, Shape, Table
+from arrange_up.model.world import ActionNoise, Push, WorldState
+from arrange_up.parallel import auto_chunksize, get_runner
+from arrange_up.physics.simulation import simulate
 
 __all__ = [
     "DATA_FORMAT",
@@ -121,14 +126,6 @@ DEFAULT_GENERATION = GenerationSettings()
 @cache
 def _scene(settings: GenerationSettings):
     """The problem the rollouts are simulated in: blocks b0..b{n-1}, a paddle, four walls."""
-    from arrange_up.model.problem import (
-        ArrangementProblem,
-        Goal,
-        ObjectKind,
-        ObjectSpec,
-        Shape,
-        Table,
-    )
 
     def box(w: float, h: float) -> Shape:
         return Shape(
@@ -178,8 +175,6 @@ class _Config:
 
 
 def _draw_config(rng: np.random.Generator, n: int, s: GenerationSettings) -> _Config:
-    from arrange_up.geometry.shapes import shadow_box
-
     d = s.block_size
     bh = s.domain.block_half
     halves: list[tuple[float, float, float]] = []
@@ -274,9 +269,6 @@ def generate_example(
     """Example ``index`` of the data set of ``seed`` (module docstring), as a JSON-ready dict:
     ``features`` and ``targets`` (one row per block, paddle side first), ``overshoot`` per
     block, rollout counts and whether the example is ``valid`` (enough rollouts at rest)."""
-    from arrange_up.model.world import ActionNoise, Push, WorldState
-    from arrange_up.physics.simulation import simulate
-
     if rollouts < 1:
         raise ValueError("rollouts must be at least 1")
     started = time.perf_counter()
@@ -426,8 +418,6 @@ def generate_dataset(
     at most 8 examples each). Returns a summary: examples present, newly computed, and the
     seconds it took.
     """
-    from arrange_up.parallel import auto_chunksize, get_runner
-
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     digest = settings.digest()

@@ -31,9 +31,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import sklearn
 from sklearn.base import BaseEstimator, MultiOutputMixin, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from arrange_up import __version__
+from arrange_up.cbst.data import DEFAULT_GENERATION, generate_dataset, load_dataset
 from arrange_up.cbst.fast_forest import FastForest
 from arrange_up.cbst.features import (
     BUCKLE_LIMIT,
@@ -44,6 +47,7 @@ from arrange_up.cbst.features import (
     Domain,
 )
 from arrange_up.io.resources import shipped_dir
+from arrange_up.parallel import available_cores
 
 __all__ = [
     "CARD_FORMAT",
@@ -438,9 +442,6 @@ def train_cbst(
 
     Returns the model card (also written as ``NAME.json``).
     """
-    from arrange_up.cbst.data import DEFAULT_GENERATION, generate_dataset, load_dataset
-    from arrange_up.parallel import available_cores
-
     workers = available_cores() if workers is None else workers
     if examples < 10:
         raise ValueError("examples must be at least 10 (8-fold CV on 90% of them)")
@@ -473,10 +474,6 @@ def train_cbst(
         progress("fit", 1, 1)
     depths = _row_depths(dataset.X, dataset.groups)
     settings = DEFAULT_GENERATION
-    import sklearn
-
-    import arrange_up
-
     card: dict[str, Any] = {
         "description": (
             "Learned PREDICT of CBST (thesis §3.2): multi-output random forest mapping "
@@ -484,7 +481,7 @@ def train_cbst(
             "cur after the push. See docs/cbst.md."
         ),
         "created": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "arrange_up_version": arrange_up.__version__,
+        "arrange_up_version": __version__,
         "sklearn_version": sklearn.__version__,
         "data": {
             "examples": dataset.examples,
