@@ -9,33 +9,10 @@
 * :mod:`~arrange_up.cbst.model`: :class:`CBSTRegressor`, tuning, storage, :func:`train_cbst`.
 
 The semantics itself is :class:`arrange_up.transitions.cbst.CBSTSemantics`
-(``plan(problem, semantics="cbst")``); see ``docs/cbst.md``. Importing this package is cheap:
-scikit-learn and networkx load with the modules that use them.
+(``plan(problem, semantics="cbst")``); see ``docs/cbst.md``.
 """
 
-from __future__ import annotations
-
-from typing import TYPE_CHECKING, Any
+from arrange_up.cbst.data import generate_dataset
+from arrange_up.cbst.model import CBSTRegressor, load_model, train_cbst
 
 __all__ = ["CBSTRegressor", "generate_dataset", "load_model", "train_cbst"]
-
-if TYPE_CHECKING:  # pragma: no cover
-    from arrange_up.cbst.data import generate_dataset
-    from arrange_up.cbst.model import CBSTRegressor, load_model, train_cbst
-
-_LAZY = {
-    "CBSTRegressor": "arrange_up.cbst.model",
-    "load_model": "arrange_up.cbst.model",
-    "train_cbst": "arrange_up.cbst.model",
-    "generate_dataset": "arrange_up.cbst.data",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'arrange_up.cbst' has no attribute {name!r}")
