@@ -43,6 +43,7 @@ from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind,
 
 __all__ = [
     "PART_COLORS",
+    "compose",
     "draw_goal",
     "draw_heatmap",
     "draw_initial",
@@ -110,7 +111,7 @@ def goal_tolerance_half_widths(problem: ArrangementProblem) -> HalfWidths:
     return (dx, dy, math.pi if dtheta is None else dtheta)
 
 
-def _compose(reference: Pose, relative: Pose) -> Pose:
+def compose(reference: Pose, relative: Pose) -> Pose:
     """The world pose of ``relative`` (a pose in the frame of ``reference``)."""
     xr, yr, tr = reference
     x, y, t = relative
@@ -432,7 +433,7 @@ def draw_relative_goal(
     )
     for name, relative in goal.targets:
         artists += _draw_target(
-            ax, problem, name, _compose(reference_pose, relative), tolerance=tolerance
+            ax, problem, name, compose(reference_pose, relative), tolerance=tolerance
         )
     if title:
         ax.set_title(f"relative goal (reference: {goal.reference})", fontsize=10)
