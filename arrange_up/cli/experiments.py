@@ -69,7 +69,9 @@ def experiment() -> None:
     """Reproduce the thesis's experiments (CSV of every measurement + PNG summary).
 
     Results are appended as they are measured; re-running the same command resumes, skipping
-    what the CSV already holds.
+    what the CSV already holds. Each command first prints how many measurements it will make
+    and about how long they take (from measured costs), then a line per measurement as it
+    ends, and the result table on stdout at the end.
     """
 
 

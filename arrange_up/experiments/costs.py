@@ -2,7 +2,7 @@
 experiment command can say how long it will take before it starts.
 
 The figures are those of the runs behind ``docs/results.md`` (its commands, on the 2-core
-development machine while other jobs ran; docs/design/experiments.md says how each was read
+development machine while other jobs ran; docs/design/figures.md says how each was read
 from the CSVs in ``docs/results/``). They are estimates: wall times on a shared machine vary
 by a factor of two, and a configuration not in the table (another problem, planner or particle
 count) is reported as unknown rather than guessed, except where a cost scales with something

@@ -11,8 +11,8 @@ legend.
 
 The layers are drawn so that they cannot be confused: the goal as solid green outlines, the
 predicted belief shadows as translucent hulls with dashed boxes in the part's colour, the
-nominal poses filled, the rollouts in translucent grey (red from the action where a rollout
-failed), a place's commanded pose dotted black.
+nominal poses filled, the rollouts in translucent grey (thin black outlines from the action
+where a rollout failed), a place's commanded pose dotted black.
 
 Between two recorded states ``t`` interpolates poses linearly (angles the short way round),
 an object placed fades in and an object picked fades out: the physics records the state after
@@ -55,7 +55,9 @@ __all__ = [
 
 ROLLOUT_COLOR = "0.35"
 ROLLOUT_ALPHA = 0.07
-FAILED_COLOR = "tab:red"
+#: Failed rollouts are thin black outlines (the part colours include red and grey).
+FAILED_COLOR = "black"
+FAILED_ALPHA = 0.3
 GOAL_COLOR = "#1a9850"
 
 #: (name, pose, opacity) of one object.
@@ -181,7 +183,7 @@ def draw_goal_outlines(
         pose = render.compose(reference_pose, target) if goal.is_relative else target
         spec = problem.object(name)
         artists += render.draw_object(
-            ax, spec, pose, color=GOAL_COLOR, fill=False, linewidth=1.6, zorder=3.5
+            ax, spec, pose, color=GOAL_COLOR, fill=False, linewidth=2.0, zorder=3.5
         )
         if half[0] > 0 or half[1] > 0:
             artists += ax.plot(
@@ -204,15 +206,27 @@ def draw_scene(ax: Axes, problem: ArrangementProblem, scene: Scene) -> None:
     draw_goal_outlines(ax, problem, reference_pose=reference)
     for placed, failed in scene.rollouts:
         for name, pose, alpha in placed:
-            render.draw_object(
-                ax,
-                problem.object(name),
-                pose,
-                color=FAILED_COLOR if failed else ROLLOUT_COLOR,
-                alpha=ROLLOUT_ALPHA * alpha * (1.5 if failed else 1.0),
-                linewidth=0.0,
-                zorder=2.5,
-            )
+            if failed:
+                render.draw_object(
+                    ax,
+                    problem.object(name),
+                    pose,
+                    color=FAILED_COLOR,
+                    fill=False,
+                    alpha=FAILED_ALPHA,
+                    linewidth=0.6,
+                    zorder=2.6,
+                )
+            else:
+                render.draw_object(
+                    ax,
+                    problem.object(name),
+                    pose,
+                    color=ROLLOUT_COLOR,
+                    alpha=ROLLOUT_ALPHA * alpha,
+                    linewidth=0.0,
+                    zorder=2.5,
+                )
     for name, center, half, alpha in scene.shadows:
         render.draw_shadows(
             ax,
@@ -322,7 +336,9 @@ def legend_handles(
         handles.append(
             Patch(facecolor=ROLLOUT_COLOR, alpha=0.4, label=f"{rollouts} noisy rollouts")
         )
-        handles.append(Patch(facecolor=FAILED_COLOR, alpha=0.4, label="rollout failed"))
+        handles.append(
+            Patch(facecolor="none", edgecolor=FAILED_COLOR, linewidth=0.6, label="rollout failed")
+        )
     kinds = {type(a) for a in actions}
     if Place in kinds:
         handles.append(Line2D([], [], color="black", linestyle=":", label="commanded place"))
