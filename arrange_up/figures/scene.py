@@ -353,7 +353,10 @@ def legend_handles(
 def prediction_label(semantics: str, particles: int, plan_semantics: str | None) -> str:
     """What the shadows show, for a figure's title: the semantics replayed and, when the plan
     was made otherwise (e.g. a repaired plan), that this is a replay of the plan."""
-    what = f"{semantics}, {particles} particles" if semantics == "particles" else semantics
     if plan_semantics is None or plan_semantics == semantics:
+        what = f"{semantics}, {particles} particles" if semantics == "particles" else semantics
         return f"predicted shadows ({what})"
-    return f"{plan_semantics} plan; shadows predicted by replaying it in the {what} semantics"
+    what = f"the {semantics} semantics"
+    if semantics == "particles":
+        what = f"the particle semantics with {particles} particles"
+    return f"{plan_semantics} plan; shadows predicted by replaying it in {what}"
