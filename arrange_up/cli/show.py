@@ -186,11 +186,17 @@ def show(
                 seed=seed,
                 fps=fps,
                 frames_per_action=frames_per_action,
-                dpi=min(dpi, 150),
+                dpi=dpi if _given("dpi") else library_default(animate_plan, "dpi"),
                 progress=progress,
                 **prediction,
             )
         click.echo(f"wrote {path}")
+
+
+def _given(option: str) -> bool:
+    """Whether ``option`` was given on the command line (not left to its default)."""
+    source = click.get_current_context().get_parameter_source(option)
+    return source is click.core.ParameterSource.COMMANDLINE
 
 
 def _prediction(document: dict[str, Any]) -> dict[str, Any]:

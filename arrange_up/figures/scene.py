@@ -71,9 +71,8 @@ class Scene:
     ``nominal``: (name, pose, opacity) of each object of the noise-free execution;
     ``shadows``: (name, centre, half-widths, opacity) of each predicted belief interval;
     ``rollouts``: for each noisy rollout, its objects and whether it has failed by then.
-    ``nominal_failed`` and ``no_prediction`` say the noise-free execution failed or the
-    semantics made no prediction at this action (then the last state or belief before is
-    shown, or nothing).
+    ``nominal_failed`` says the noise-free execution failed by this action (its last state is
+    shown), ``no_prediction`` that the semantics made no prediction here (no shadows shown).
     """
 
     nominal: tuple[Placed, ...]
@@ -127,7 +126,7 @@ def scene_at(data: dict[str, Any], k: int, t: float = 1.0) -> Scene:
     failed = nominal[k] is None
     if last is None:
         poses: list[Placed] = []
-    elif failed or k == 0 or last < k - 1:
+    elif failed or k == 0:
         poses = [(n, p, 1.0) for n, p in nominal[last].poses]
     else:
         poses = _blend(dict(nominal[k - 1].poses), dict(nominal[k].poses), t, _lerp_pose)
