@@ -1,11 +1,21 @@
-"""The ``experiment`` commands: the thesis's experiments, resumable, as CSV and PNG."""
+"""The ``experiment`` commands: the thesis's experiments, resumable, as CSV and PNG.
+
+Every command prints, before it starts, how many measurements it will make and about how long
+they take (from the measured costs of :mod:`arrange_up.experiments.costs`), then a line per
+measurement as it is made (on a terminal, a live line with the count and the elapsed time, the
+finished measurements printed above it), and at the end the result table on stdout.
+"""
 
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import click
+from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
@@ -17,7 +27,10 @@ from arrange_up.cli.shared import (
     library_default,
     load_problem,
     parallel_options,
+    terminal_progress,
 )
+from arrange_up.experiments import costs
+from arrange_up.experiments.csv_records import read_csv
 from arrange_up.experiments.fixtures import (
     CSV_NAME,
     DEFAULT_PARTICLES,
@@ -25,15 +38,23 @@ from arrange_up.experiments.fixtures import (
     StaleResultsError,
     fixture_experiment,
     markdown_table,
+    pending_rows,
     read_rows,
     select_rows,
     summarize,
 )
 from arrange_up.experiments.planning import (
+    SEARCH_TYPES,
     Planner,
     default_planners,
+    pending_searches,
+    pending_transition_runs,
+    search_markdown,
     search_table,
+    select_search_rows,
+    select_transition_rows,
     transition_comparison,
+    transition_markdown,
 )
 from arrange_up.parallel import BackendUnavailableError
 from arrange_up.repair.fixture_repair import METHODS
@@ -48,12 +69,91 @@ def experiment() -> None:
     """Reproduce the thesis's experiments (CSV of every measurement + PNG summary).
 
     Results are appended as they are measured; re-running the same command resumes, skipping
-    what the CSV already holds.
+    what the CSV already holds. Each command first prints how many measurements it will make
+    and about how long they take (from measured costs), then a line per measurement as it
+    ends, and the result table on stdout at the end.
     """
 
 
 def _say(message: str) -> None:
     click.echo(f"[{time.strftime('%H:%M:%S')}] {message}", err=True)
+
+
+class _Measurements:
+    """Progress per measurement: ``say`` a stage, ``done`` a finished measurement (counted, with
+    the elapsed time and, from the pace so far, the time left)."""
+
+    def __init__(self, display: Any, total: int) -> None:
+        self.display, self.total, self.count = display, total, 0
+        self.started = time.perf_counter()
+        self.task = display.add_task("starting", total=total) if display is not None else None
+
+    def say(self, message: str) -> None:
+        if self.display is None:
+            _say(message)
+        else:
+            self.display.update(self.task, description=message)
+
+    def done(self, line: str) -> None:
+        self.count += 1
+        elapsed = time.perf_counter() - self.started
+        left = elapsed / self.count * max(0, self.total - self.count)
+        pace = f"{self.count}/{self.total} done, {costs.format_duration(elapsed)} elapsed"
+        if self.count < self.total:
+            pace += f", about {costs.format_duration(left)} left"
+        if self.display is None:
+            _say(f"{line} [{pace}]")
+        else:
+            self.display.console.print(f"[{time.strftime('%H:%M:%S')}] {line}", highlight=False)
+            self.display.update(self.task, completed=self.count)
+
+
+@contextmanager
+def _measurements(estimate: costs.Estimate, total: int) -> Iterator[_Measurements]:
+    """Print the duration estimate, then report each measurement (the CLI's progress
+    display on a terminal, lines on stderr otherwise)."""
+    _say(f"estimate: {estimate.describe(total)}")
+    columns = (
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+    )
+    with terminal_progress(*columns) as display:
+        yield _Measurements(display, total)
+
+
+def _transition_line(row: dict[str, Any]) -> str:
+    """One finished planning run (and its evaluation), saying how it ended."""
+    head = f"{row['problem']} {row['planner']} run {int(row['run']) + 1}"
+    seconds, nodes = row["planning_seconds"], row["expanded"]
+    if not row["solved"]:
+        ended = "node limit" if row["status"] == "node-limit" else row["status"]
+        return f"{head}: no plan: {ended} after {nodes} nodes, {seconds} s"
+    line = f"{head}: solved in {seconds} s, {nodes} nodes, {row['plan_length']} actions"
+    if row["rollouts"] != "":
+        line += f"; {row['successes']}/{row['rollouts']} rollouts reached the goal"
+    return line
+
+
+def _search_line(row: dict[str, Any]) -> str:
+    head = f"{row['search']} domination={row['domination']} {row['problem']}"
+    if not row["solved"]:
+        ended = "node limit" if row["status"] == "node-limit" else row["status"]
+        return f"{head}: no plan: {ended} after {row['expanded']} nodes, {row['seconds']} s"
+    return f"{head}: solved, {row['expanded']} nodes, cost {row['cost']}, {row['seconds']} s"
+
+
+def _fixture_line(row: dict[str, Any]) -> str:
+    what = f"{row['problem']} plan {int(row['plan']) + 1} {row['stage']}"
+    if row["particles"] != "":
+        what += f" ({row['particles']} particles)"
+    line = f"{what}: {row['status']}"
+    if row["reason"]:
+        line += f" ({row['reason']})"
+    if row.get("rollouts", "") != "":
+        line += f"; {row['successes']}/{row['rollouts']} rollouts reached the goal"
+    return line
 
 
 def _refuse_bad_problems(names: list[str]) -> None:
@@ -135,18 +235,32 @@ def experiment_transition_comparison(
     for name in names:
         check_semantics(name)
         planners.append(Planner(name, name, 1))
-    _refuse_bad_problems(problems.split(","))
-    path = transition_comparison(
-        Path(output_dir),
-        problems=problems.split(","),
-        planners=planners,
-        runs=runs,
-        rollouts=rollouts,
-        max_nodes=max_nodes,
-        timeout=timeout,
-        workers=workers,
-        progress=_say,
-    )
+    names = [n.strip() for n in problems.split(",") if n.strip()]
+    _refuse_bad_problems(names)
+    pending = pending_transition_runs(Path(output_dir), names, planners, runs)
+    estimate = costs.Estimate()
+    for name, label, _run in pending:
+        planning = costs.planning_cost(name, label, max_nodes)
+        if planning is not None and timeout is not None:
+            planning = min(planning, timeout)
+        evaluation = costs.rollout_cost(name, rollouts)
+        total = None if planning is None or evaluation is None else planning + evaluation
+        estimate.add(total, f"{name} {label}")
+    with _measurements(estimate, len(pending)) as report:
+        path = transition_comparison(
+            Path(output_dir),
+            problems=names,
+            planners=planners,
+            runs=runs,
+            rollouts=rollouts,
+            max_nodes=max_nodes,
+            timeout=timeout,
+            workers=workers,
+            progress=report.say,
+            measured=lambda row: report.done(_transition_line(row)),
+        )
+    rows = select_transition_rows(read_csv(path), names, [p.label for p in planners], runs)
+    click.echo(transition_markdown(rows))
     click.echo(f"wrote {path} and {path.with_suffix('.png')}")
 
 
@@ -204,17 +318,30 @@ def experiment_search_table(
     if semantics is None:
         semantics = "cbst" if "cbst" in available() else "deterministic"
     check_semantics(semantics)
-    _refuse_bad_problems(problems.split(","))
-    path = search_table(
-        Path(output_dir),
-        problems=problems.split(","),
-        semantics=semantics,
-        particles=particles,
-        max_nodes=max_nodes,
-        weight=weight,
-        timeout=timeout,
-        progress=_say,
-    )
+    names = [n.strip() for n in problems.split(",") if n.strip()]
+    _refuse_bad_problems(names)
+    pending = pending_searches(Path(output_dir), names, semantics)
+    estimate = costs.Estimate()
+    for k, domination, name in pending:
+        cost = costs.search_cost(semantics, name, k, domination, max_nodes)
+        if cost is not None and timeout is not None:
+            cost = min(cost, timeout)
+        if particles != library_default(search_table, "particles") or weight != 1.0:
+            cost = None  # measured with one particle and A* only
+        estimate.add(cost, f"{SEARCH_TYPES[k][0]} {name}")
+    with _measurements(estimate, len(pending)) as report:
+        path = search_table(
+            Path(output_dir),
+            problems=names,
+            semantics=semantics,
+            particles=particles,
+            max_nodes=max_nodes,
+            weight=weight,
+            timeout=timeout,
+            progress=report.say,
+            measured=lambda row: report.done(_search_line(row)),
+        )
+    click.echo(search_markdown(select_search_rows(read_csv(path), names, semantics)))
     click.echo(f"wrote {path} and {path.parent / f'search-table-{semantics}.png'}")
 
 
@@ -332,21 +459,29 @@ def experiment_fixtures(
     if not names:
         fail("--problems: expected at least one problem")
     _refuse_bad_problems(names)
+    pending = pending_rows(
+        Path(output_dir), problems=names, plans=plans, particles=counts, seed=seed, method=method
+    )
+    estimate = costs.Estimate()
+    for name, count in pending:
+        estimate.add(costs.fixture_cost(name, count, rollouts), name)
     try:
-        path = fixture_experiment(
-            Path(output_dir),
-            problems=names,
-            plans=plans,
-            particles=counts,
-            rollouts=rollouts,
-            seed=seed,
-            method=method,
-            timeout=timeout,
-            workers=workers,
-            backend=backend,
-            scheduler=scheduler,
-            progress=_say,
-        )
+        with _measurements(estimate, len(pending)) as report:
+            path = fixture_experiment(
+                Path(output_dir),
+                problems=names,
+                plans=plans,
+                particles=counts,
+                rollouts=rollouts,
+                seed=seed,
+                method=method,
+                timeout=timeout,
+                workers=workers,
+                backend=backend,
+                scheduler=scheduler,
+                progress=report.say,
+                measured=lambda row: report.done(_fixture_line(row)),
+            )
     except KeyboardInterrupt:
         fail(
             f"interrupted; the rows measured so far are in {Path(output_dir) / CSV_NAME}: "

@@ -42,7 +42,7 @@ from __future__ import annotations
 import csv
 import math
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -68,6 +68,7 @@ __all__ = [
     "SummaryRow",
     "fixture_experiment",
     "markdown_table",
+    "pending_rows",
     "plot_fixture_experiment",
     "read_rows",
     "select_rows",
@@ -142,6 +143,7 @@ def fixture_experiment(
     scheduler: str | None = None,
     max_tries: int | None = None,
     progress: Progress | None = None,
+    measured: Callable[[dict[str, Any]], None] | None = None,
 ) -> Path:
     """Run (or resume) the chapter-4 experiment; returns the CSV path (module docstring).
 
@@ -154,6 +156,8 @@ def fixture_experiment(
     ``scheduler`` to the evaluation only. ``max_tries`` is passed to ``nominal_plans``
     (default ``10 * max(plans, 20) + 10``, independent of ``plans`` up to 20, which keeps the
     plan lists of different ``plans`` prefixes of each other).
+
+    ``progress`` gets a line of text at each stage, ``measured`` every row as it is written.
 
     Raises ``ValueError`` for bad sizes, :class:`StaleResultsError` (see module docstring),
     and whatever the evaluation raises for a bad backend.
@@ -203,6 +207,8 @@ def fixture_experiment(
         def write(row: dict[str, Any]) -> None:
             append(row)
             done.add(_key(*(row[f] for f in _KEY)))  # a repeated problem or count is done too
+            if measured is not None:
+                measured(row)
 
         for name in problems:
             problem = load(name)
@@ -272,6 +278,32 @@ def fixture_experiment(
     )
     plot_fixture_experiment(selected, Path(output_dir))
     return path
+
+
+def pending_rows(
+    output_dir: Path,
+    *,
+    problems: Sequence[str],
+    plans: int,
+    particles: Sequence[int],
+    seed: int,
+    method: str,
+) -> list[tuple[str, int | None]]:
+    """The (problem, particles; None for the nominal plan) of each row a
+    :func:`fixture_experiment` call would write, if every nominal plan is found: those not yet
+    in ``output_dir``'s CSV."""
+    done = done_keys(Path(output_dir) / CSV_NAME, _KEY)
+    pending: list[tuple[str, int | None]] = []
+    for name in dict.fromkeys(problems):
+        for j in range(plans):
+            if _key(name, seed, j, NOMINAL, "", "") not in done:
+                pending.append((name, None))
+            pending += [
+                (name, n)
+                for n in dict.fromkeys(particles)
+                if _key(name, seed, j, REPAIRED, str(n), method) not in done
+            ]
+    return pending
 
 
 def read_rows(path: Path) -> list[dict[str, str]]:

@@ -44,6 +44,7 @@ from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind,
 
 __all__ = [
     "PART_COLORS",
+    "compose",
     "draw_goal",
     "draw_heatmap",
     "draw_initial",

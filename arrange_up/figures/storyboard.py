@@ -12,7 +12,9 @@ Each panel shows the state after its action:
 * the poses reached by ``rollouts`` noisy rollouts, overlaid in grey — rollout ``i`` is the
   same as rollout ``i`` of ``arrange-up evaluate`` with the same seed.
 
-The first panel shows the start; the goal is drawn faintly in every panel.
+The first panel shows the start; the goal is drawn in every panel as solid green outlines
+(:mod:`arrange_up.figures.scene` draws the layers, the same way as the animation's frames), a
+legend below the panels says which layer is which, the axes are in the problem's length unit.
 """
 
 from __future__ import annotations
@@ -23,23 +25,21 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.evaluation.evaluate import trace_rollout
-from arrange_up.figures import render
 from arrange_up.figures.backend import pyplot
-from arrange_up.model.problem import ArrangementProblem, ObjectKind
-from arrange_up.model.world import (
-    Action,
-    Pick,
-    Place,
-    Push,
-    WorldState,
-    nominal_initial_state,
-    nominal_noise,
+from arrange_up.figures.scene import (
+    describe,
+    draw_action,
+    draw_scene,
+    has_shadows,
+    legend_handles,
+    prediction_label,
+    scene_at,
+    style_axes,
 )
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action, WorldState, nominal_initial_state, nominal_noise
 from arrange_up.physics.simulation import simulate
 from arrange_up.transitions import make_semantics
-
-ROLLOUT_COLOR = "0.35"
-ROLLOUT_ALPHA = 0.07
 
 
 def storyboard_data(
@@ -98,11 +98,17 @@ def draw_storyboard(
     semantics: str = "deterministic",
     particles: int = 1,
     plan_seed: int = 0,
+    plan_semantics: str | None = None,
     columns: int = 4,
     dpi: int = 110,
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
-    """Draw the storyboard of a plan into a PNG (see the module docstring)."""
+    """Draw the storyboard of a plan into a PNG (see the module docstring).
+
+    ``semantics``, ``particles`` and ``plan_seed`` are those the shadows are predicted with;
+    ``plan_semantics`` is what the plan file records when it differs (e.g. ``fixtures`` for a
+    repaired plan), and the title then says the shadows are a replay.
+    """
     data = storyboard_data(
         problem,
         actions,
@@ -122,7 +128,10 @@ def draw_storyboard(
     fig, axes = plt.subplots(
         rows,
         columns,
-        figsize=(columns * width * scale + 0.4, rows * depth * scale + 0.9),
+        figsize=(
+            columns * width * scale + 0.4,
+            rows * (depth * scale + LABEL_HEIGHT) + LEGEND_HEIGHT + 0.9,
+        ),
         squeeze=False,
     )
     try:
@@ -132,12 +141,17 @@ def draw_storyboard(
                 ax.axis("off")
                 continue
             _draw_panel(ax, problem, data, actions, k)
-        fig.suptitle(
-            f"{problem.name}: {len(actions)} actions, {rollouts} noisy rollouts in grey, "
-            f"predicted shadows ({semantics})",
-            fontsize=10,
+        label = prediction_label(semantics, particles, plan_semantics)
+        fig.suptitle(f"{problem.name}: {len(actions)} actions; {label}", fontsize=10)
+        handles = legend_handles(problem, actions, rollouts=rollouts, shadows=has_shadows(data))
+        fig.legend(
+            handles=handles,
+            loc="lower center",
+            ncol=min(len(handles), max(2, columns * 2)),
+            fontsize=7,
+            frameon=False,
         )
-        fig.tight_layout()
+        fig.tight_layout(rect=(0, LEGEND_HEIGHT / fig.get_figheight(), 1, 1))
         output = Path(output)
         output.parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(output, dpi=dpi)
@@ -146,83 +160,20 @@ def draw_storyboard(
     return output
 
 
+#: Inches below the panels for the legend, and below each row for its axis labels.
+LEGEND_HEIGHT = 0.5
+LABEL_HEIGHT = 0.3
+
+
 def _draw_panel(ax, problem: ArrangementProblem, data, actions, k: int) -> None:
-    render.draw_table(ax, problem)
-    if not problem.goal.is_relative:
-        for artist in render.draw_goal(ax, problem, tolerance=False):
-            artist.set_alpha(0.35)
-    # Rollouts in grey.
-    for trace in data["rollouts"]:
-        if k < len(trace):
-            for name, pose in trace[k].poses:
-                render.draw_object(
-                    ax,
-                    problem.object(name),
-                    pose,
-                    color=ROLLOUT_COLOR,
-                    alpha=ROLLOUT_ALPHA,
-                    linewidth=0.0,
-                    zorder=2.5,
-                )
-    # Predicted belief shadows.
-    belief = data["beliefs"][k]
-    if belief is not None:
-        for name, interval in belief.intervals.objects:
-            color = render.object_color(problem, name)
-            render.draw_shadows(
-                ax, problem.object(name), interval.center, interval.half, color=color, zorder=2
-            )
-    # Nominal poses.
-    state = data["nominal"][k]
-    if state is not None:
-        for name, pose in state.poses:
-            color = render.object_color(problem, name)
-            render.draw_object(ax, problem.object(name), pose, color=color, label=name, zorder=4)
-    title = "start" if k == 0 else f"{k}. {_describe(actions[k - 1], problem)}"
+    scene = scene_at(data, k)
+    draw_scene(ax, problem, scene)
+    title = "start" if k == 0 else f"{k}. {describe(actions[k - 1], problem)}"
     if k > 0:
-        _draw_action(ax, problem, actions[k - 1])
-        if state is None:
+        draw_action(ax, problem, actions[k - 1])
+        if scene.nominal_failed:
             title += " (nominal failed)"
-        if belief is None:
+        if scene.no_prediction:
             title += " (no prediction)"
     ax.set_title(title, fontsize=8)
-    ax.set_aspect("equal")
-    width, depth = problem.table.size
-    ax.set_xlim(-0.6, width + 0.6)
-    ax.set_ylim(-0.6, depth + 0.6)
-    ax.tick_params(labelsize=6)
-
-
-def _draw_action(ax, problem: ArrangementProblem, action: Action) -> None:
-    if isinstance(action, Place):
-        spec = problem.object(action.obj)
-        render.draw_object(
-            ax, spec, action.pose, color="black", fill=False, linestyle=":", zorder=5
-        )
-    elif isinstance(action, Push):
-        spec = problem.object(action.manipulator)
-        render.draw_object(ax, spec, action.pose, color="0.15", zorder=5)
-        px, py = spec.push_direction
-        c, s = math.cos(action.pose[2]), math.sin(action.pose[2])
-        dx, dy = (c * px - s * py) * action.distance, (s * px + c * py) * action.distance
-        ax.annotate(
-            "",
-            xy=(action.pose[0] + dx, action.pose[1] + dy),
-            xytext=(action.pose[0], action.pose[1]),
-            arrowprops={"arrowstyle": "->", "color": "black", "lw": 1.2},
-            zorder=6,
-        )
-    elif isinstance(action, Pick):
-        spec = problem.object(action.obj)
-        if spec.kind is not ObjectKind.OBSTACLE:
-            ax.text(0.02, 0.95, f"pick {action.obj}", transform=ax.transAxes, fontsize=7, va="top")
-
-
-def _describe(action: Action, problem: ArrangementProblem) -> str:
-    units = problem.units
-    if isinstance(action, Place):
-        x, y, t = units.pose_out(action.pose)
-        return f"place {action.obj} at ({x:.2f}, {y:.2f}, {t:.0f})"
-    if isinstance(action, Push):
-        return f"push {units.length_out(action.distance):.2f} {units.length}"
-    return f"pick {action.obj}"
+    style_axes(ax, problem, fontsize=7)

@@ -13,7 +13,13 @@ from catalogue import tiny
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.evaluation.evaluate import trace_rollout
 from arrange_up.figures.backend import pyplot
-from arrange_up.figures.storyboard import _describe, draw_storyboard, storyboard_data
+from arrange_up.figures.scene import describe
+from arrange_up.figures.storyboard import (
+    LABEL_HEIGHT,
+    LEGEND_HEIGHT,
+    draw_storyboard,
+    storyboard_data,
+)
 from arrange_up.model.world import Pick, Place, Push
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -81,13 +87,12 @@ def test_draw_storyboard_writes_a_png_of_one_panel_per_action(tmp_path):
     dpi = 40
     assert draw_storyboard(problem, PLAN, out, rollouts=2, columns=2, dpi=dpi) == out
     # Two columns of four panels (the start and three actions): 2 x 2; the figure is sized
-    # from the table (5 x 3 in at 3.6 in per longest side).
+    # from the table (5 x 3 in at 3.6 in per longest side), with room for the legend below.
     scale = 3.6 / 5.0
 
     def pixels(columns, rows):  # up to a pixel of rounding
-        return pytest.approx(
-            ((columns * 5.0 * scale + 0.4) * dpi, (rows * 3.0 * scale + 0.9) * dpi), abs=1.0
-        )
+        height = rows * (3.0 * scale + LABEL_HEIGHT) + LEGEND_HEIGHT + 0.9
+        return pytest.approx(((columns * 5.0 * scale + 0.4) * dpi, height * dpi), abs=1.0)
 
     assert png_size(out) == pixels(2, 2)
     # More columns than panels: one row of four.
@@ -110,7 +115,7 @@ def test_draw_storyboard_of_a_fixture_plan_with_particles_closes_its_figure(tmp_
 
 def test_panel_titles_quote_the_problems_units():
     inch, mm = tiny("one-block"), tiny("millimetres")
-    assert _describe(PLAN[0], inch) == "place A at (4.09, 0.91, 0)"
-    assert _describe(PLAN[0], mm) == "place A at (103.84, 23.16, 0)"
-    assert _describe(PLAN[1], mm) == "push 13.90 mm"
-    assert _describe(Pick("A"), mm) == "pick A"
+    assert describe(PLAN[0], inch) == "place A at (4.09, 0.91, 0)"
+    assert describe(PLAN[0], mm) == "place A at (103.84, 23.16, 0)"
+    assert describe(PLAN[1], mm) == "push 13.90 mm"
+    assert describe(Pick("A"), mm) == "pick A"
