@@ -6,7 +6,15 @@ from pathlib import Path
 
 import click
 
-from arrange_up.cli.shared import fail, library_default, load_problem, read_plan_file
+from arrange_up.cli.shared import (
+    SEED,
+    OutputFile,
+    fail,
+    library_default,
+    load_problem,
+    read_plan_file,
+)
+from arrange_up.figures.backend import FIGURE_SUFFIXES
 from arrange_up.figures.render import draw_problem, write_heatmap
 from arrange_up.figures.storyboard import draw_storyboard
 from arrange_up.parallel import available_cores
@@ -19,9 +27,9 @@ from arrange_up.transitions import available
 @click.option(
     "--output",
     "-o",
-    type=click.Path(dir_okay=False, writable=True),
+    type=OutputFile(FIGURE_SUFFIXES),
     required=True,
-    help="Where to write the picture (.png).",
+    help="Where to write the picture (.png, .svg or .pdf).",
 )
 @click.option(
     "--dpi",
@@ -45,7 +53,7 @@ from arrange_up.transitions import available
 )
 @click.option(
     "--seed",
-    type=int,
+    type=SEED,
     default=0,
     show_default=True,
     help="Seed of the storyboard's rollouts (as in `evaluate`).",

@@ -36,7 +36,7 @@ from matplotlib.patches import Patch, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
 from shapely.geometry import Polygon
 
-from arrange_up.figures.backend import pyplot
+from arrange_up.figures.backend import figure_format, pyplot
 from arrange_up.geometry import shapes as geometry
 from arrange_up.io.domains import first_sentence
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, ObjectSpec, Pose
@@ -623,7 +623,8 @@ def draw_problem(
     title: str | None = None,
     dpi: int = 150,
 ) -> Path:
-    """Draw ``problem`` and save it as a PNG at ``output``; returns the path written.
+    """Draw ``problem`` and save it at ``output`` in the format its suffix names (PNG, SVG or
+    PDF: :func:`~arrange_up.figures.backend.figure_format`); returns the path written.
 
     The picture shows the table with its walls and obstacles, every object on the table at its
     nominal initial pose (filled, labelled) with its belief shadows, and the goal: for an
@@ -638,7 +639,7 @@ def draw_problem(
         output.parent.mkdir(parents=True, exist_ok=True)
     fig = problem_figure(problem, title=title)
     try:
-        fig.savefig(output, dpi=dpi, bbox_inches="tight", format="png")
+        fig.savefig(output, dpi=dpi, bbox_inches="tight", format=figure_format(output))
     finally:
         plt.close(fig)
     return output
@@ -891,14 +892,15 @@ def write_heatmap(
     title: str | None = None,
     **kwargs: Any,
 ) -> Path:
-    """Save :func:`heatmap_figure` of ``scores`` as a PNG at ``output``; returns the path."""
+    """Save :func:`heatmap_figure` of ``scores`` at ``output`` (PNG, SVG or PDF, by its
+    suffix); returns the path."""
     plt = pyplot()
     output = Path(output)
     if output.parent != Path(""):
         output.parent.mkdir(parents=True, exist_ok=True)
     fig = heatmap_figure(problem, scores, title=title, **kwargs)
     try:
-        fig.savefig(output, dpi=dpi, bbox_inches="tight", format="png")
+        fig.savefig(output, dpi=dpi, bbox_inches="tight", format=figure_format(output))
     finally:
         plt.close(fig)
     return output

@@ -24,7 +24,7 @@ from typing import Any
 
 from arrange_up.evaluation.evaluate import trace_rollout
 from arrange_up.figures import render
-from arrange_up.figures.backend import pyplot
+from arrange_up.figures.backend import figure_format, pyplot
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import (
     Action,
@@ -140,7 +140,7 @@ def draw_storyboard(
         fig.tight_layout()
         output = Path(output)
         output.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(output, dpi=dpi)
+        fig.savefig(output, dpi=dpi, format=figure_format(output))
     finally:
         plt.close(fig)
     return output

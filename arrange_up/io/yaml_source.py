@@ -24,6 +24,7 @@ from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
 from ruamel.yaml.reader import ReaderError
 from ruamel.yaml.scalarbool import ScalarBoolean
 
+from arrange_up.io.validation import angle_problem
 from arrange_up.model.errors import Diagnostic
 from arrange_up.model.problem import Pose
 from arrange_up.model.units import Units
@@ -110,6 +111,9 @@ def parse(text: str, report: Report) -> Any:
         return None
     except RecursionError:
         report.error(None, "", "not a problem file: the YAML is nested too deeply")
+        return None
+    except ValueError as error:  # an integer of more digits than Python converts
+        report.error(None, "", f"not a problem file: {_one_line(str(error))}")
         return None
 
     if node is None or data is None:
@@ -420,14 +424,28 @@ class NodeReader:
                 ok = False
         return values if ok else None
 
+    def angle(self, node: Node, value: float) -> float | None:
+        """``value`` (the file's angle unit, read from ``node``) in radians, or None after
+        reporting an angle too large to mean an orientation (:data:`validation.MAX_ANGLE`)."""
+        radians = self.units.angle_in(value)
+        reason = angle_problem(radians)
+        if reason is not None:
+            self.error(node, f"angle {fmt(value)} {self.units.angle}: {reason}")
+            return None
+        return radians
+
     def pose(self, node: Node) -> Pose | None:
         values = self.vector(node, ("x", "y", "theta"))
-        return None if values is None else self.units.pose_in(values)  # type: ignore[arg-type]
+        if values is None or self.angle(node.items()[2], values[2]) is None:
+            return None
+        return self.units.pose_in(values)  # type: ignore[arg-type]
 
     def half_widths(self, node: Node) -> tuple[float, float, float] | None:
         values = self.vector(node, ("dx", "dy", "dtheta"))
         values = self.non_negative(node, values, "half-width")
-        return None if values is None else self.units.pose_in(values)  # type: ignore[arg-type]
+        if values is None or self.angle(node.items()[2], values[2]) is None:
+            return None
+        return self.units.pose_in(values)  # type: ignore[arg-type]
 
     def list_of(self, node: Node, expected: str) -> list[Node] | None:
         if not node.is_seq or not node.value:
@@ -436,8 +454,13 @@ class NodeReader:
             return None
         return node.items()
 
-    def range(self, node: Node, convert: Callable[[float], float]) -> tuple[float, float] | None:
-        values = self.non_negative(node, self.vector(node, ("low", "high")), "value")
+    def range(
+        self, node: Node, convert: Callable[[float], float], *, positive: bool = False
+    ) -> tuple[float, float] | None:
+        """A uniform range ``[low, high]`` with ``0 <= low <= high`` (``0 < low`` when
+        ``positive``), converted by ``convert``."""
+        values = self.vector(node, ("low", "high"))
+        values = (self.positive if positive else self.non_negative)(node, values, "value")
         if values is None:
             return None
         low, high = values
@@ -445,7 +468,7 @@ class NodeReader:
             self.error(
                 node,
                 f"low {fmt(low)} is above high {fmt(high)}; expected [low, high] "
-                "with 0 <= low <= high",
+                f"with 0 {'<' if positive else '<='} low <= high",
             )
             return None
         return (convert(low), convert(high))
