@@ -233,7 +233,14 @@ def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnos
     line = column = None
     message = str(error).strip() or type(error).__name__
     if isinstance(error, RecursionError):
-        return Diagnostic(source, None, None, "", "not valid PDDL: nested too deeply")
+        return Diagnostic(
+            source,
+            None,
+            None,
+            "",
+            "not valid PDDL: nested too deeply; expected a (define (problem ...)) of the "
+            f"{DOMAIN_NAME} domain",
+        )
     if hasattr(error, "lineno") and hasattr(error, "col"):  # pyparsing's ParseException
         line, column = int(error.lineno), int(error.col)
         message = f"not valid PDDL: {getattr(error, 'msg', message)}"
@@ -242,7 +249,7 @@ def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnos
         line, column = located.find(rf"(?<![\w-]){re.escape(name)}(?![\w-])")
         message = (
             f"unknown name {name!r}: not a type, function or object of the {DOMAIN_NAME} "
-            f"domain ({DOMAIN_FILE}); object types must be shape types of "
+            f"domain ({DOMAIN_FILE}); expected object types among the shape types of "
             f"{load_catalogue().path} ({', '.join(load_catalogue().type_names)})"
         )
     else:
@@ -641,7 +648,8 @@ class _Builder:
                         f"goal.{function}({part})",
                         rf"\(\s*{function}\s+{re.escape(part)}[\s)]",
                         f"({function} {part}) must lie in [{num(float(low))}, "
-                        f"{num(float(high))}], an empty interval",
+                        f"{num(float(high))}], an empty interval; expected the (>= ...) bound "
+                        "at most the (<= ...) bound",
                     )
                     ok = False
                     break

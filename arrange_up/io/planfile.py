@@ -35,8 +35,9 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.io.validation import angle_problem
+from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, problem_hash
-from arrange_up.model.units import Units
+from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
 from arrange_up.model.world import Action, Pick, Place, Push
 
 PLAN_FORMAT = "arrange-up-plan/1"
@@ -210,9 +211,18 @@ def _read_document(path: Path) -> Any:
     try:
         return json.loads(text)
     except json.JSONDecodeError as error:
-        raise PlanFileError(f"{path}:{error.lineno}:{error.colno}: not JSON: {error.msg}") from None
+        raise PlanFileError(
+            f"{path}:{error.lineno}:{error.colno}: not JSON: {error.msg}; expected a plan "
+            "file (a JSON object)"
+        ) from None
     except ValueError as error:  # an integer of more digits than Python converts
-        raise PlanFileError(f"{path}: not a plan file: {error}") from None
+        line, column, digits = long_number(text)
+        if not digits:
+            raise PlanFileError(f"{path}: not a plan file: {error}") from None
+        raise PlanFileError(
+            f"{path}:{line}:{column}: a number of {digits} digits; expected a finite number "
+            "(a double, at most about 1e308)"
+        ) from None
 
 
 def _nesting(text: str) -> int:
@@ -258,7 +268,7 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
     if document.get("status") != "solved" or "actions" not in document:
         raise PlanFileError(
             f"{path}: status: the plan is {_shown(document.get('status'))}, not "
-            "'solved'; it holds no actions to use"
+            "'solved'; it holds no actions to use (expected a solved plan)"
         )
     raw_units = document.get("units", {})
     if not isinstance(raw_units, dict):
@@ -266,10 +276,20 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
             f'{path}: units: expected an object {{"length": ..., "angle": ...}}, got '
             f"{_json_kind(raw_units)}"
         )
-    try:
-        units = Units(raw_units.get("length", "in"), raw_units.get("angle", "deg"))
-    except (TypeError, ValueError) as error:
-        raise PlanFileError(f"{path}: units: {error}") from None
+    for key, table, default in (("length", LENGTH_UNITS, "in"), ("angle", ANGLE_UNITS, "deg")):
+        unit = raw_units.get(key, default)
+        if not isinstance(unit, str) or unit not in table:
+            raise PlanFileError(
+                f"{path}: units: unknown {key} unit {_shown(unit)}; expected one of "
+                f"{', '.join(table)}"
+            )
+    units = Units(raw_units.get("length", "in"), raw_units.get("angle", "deg"))
+    recorded = document.get("problem", {})
+    if not isinstance(recorded, dict):
+        raise PlanFileError(
+            f'{path}: problem: expected an object {{"name", "hash", "source"}} naming '
+            f"the problem the plan is for, got {_json_kind(recorded)}"
+        )
     raw_actions = document["actions"]
     if not isinstance(raw_actions, list):
         raise PlanFileError(f"{path}: actions: expected a list, got {_json_kind(raw_actions)}")

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
+import sys
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,6 +41,7 @@ __all__ = [
     "fmt",
     "is_number",
     "join",
+    "long_number",
     "parse",
     "read_text",
     "root_node",
@@ -103,17 +106,32 @@ def parse(text: str, report: Report) -> Any:
         report.error(
             (line, column),
             "",
-            f"not valid YAML: character {_char(error.character)} is not allowed in a YAML file",
+            f"not valid YAML: character {_char(error.character)} is not allowed in a YAML file; "
+            "expected printable text",
         )
         return None
     except YAMLError as error:
         report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
         return None
     except RecursionError:
-        report.error(None, "", "not a problem file: the YAML is nested too deeply")
+        report.error(
+            None,
+            "",
+            "not a problem file: the YAML is nested too deeply; expected a mapping of the "
+            "format's sections (name, table, objects, goal, ...)",
+        )
         return None
     except ValueError as error:  # an integer of more digits than Python converts
-        report.error(None, "", f"not a problem file: {_one_line(str(error))}")
+        line, column, digits = long_number(text)
+        if digits:
+            report.error(
+                (line, column),
+                "",
+                f"a number of {digits} digits; expected a finite number (a double, at most "
+                "about 1e308)",
+            )
+        else:
+            report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
         return None
 
     if node is None or data is None:
@@ -136,10 +154,22 @@ def parse(text: str, report: Report) -> Any:
         report.error(
             (line, column),
             path,
-            f"duplicate key {key!r} (first given at line {first[0]}, column {first[1]}); each "
-            "key may appear only once in a mapping",
+            f"duplicate key {key!r} (first given at line {first[0]}, column {first[1]}); "
+            "expected each key at most once in a mapping",
         )
     return data
+
+
+def long_number(text: str) -> tuple[int | None, int | None, int]:
+    """``(line, column, digits)`` of the first run of more digits than Python converts to an
+    integer (``sys.get_int_max_str_digits()``), or ``(None, None, 0)``."""
+    limit = sys.get_int_max_str_digits() if hasattr(sys, "get_int_max_str_digits") else 4300
+    match = re.search(rf"\d{{{limit + 1},}}", text) if limit else None
+    if match is None:
+        return None, None, 0
+    before = text[: match.start()]
+    line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+    return line, column, len(match.group(0))
 
 
 def _find_duplicates(root: Any) -> Iterator[tuple[int, int, str, str, tuple[int, int]]]:
