@@ -1,8 +1,8 @@
 """Pictures of problems: the table, the initial belief and the goal, like thesis Figures 2-8/2-9.
 
-:func:`draw_problem` writes one PNG of a whole problem. It is built from one helper per layer,
-each drawing onto a given matplotlib ``Axes`` so that other pictures (a storyboard with one
-panel per plan action, a report) can reuse them:
+:func:`draw_problem` writes one picture (PNG, SVG or PDF) of a whole problem. It is built from
+one helper per layer, each drawing onto a given matplotlib ``Axes`` so that other pictures (a
+storyboard with one panel per plan action, a report) can reuse them:
 
 * :func:`draw_table`: the table surface, its walls (thick dark bars on their edges) and the
   fixed obstacles (solid grey).

@@ -102,7 +102,8 @@ def draw_storyboard(
     dpi: int = 110,
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
-    """Draw the storyboard of a plan into a PNG (see the module docstring)."""
+    """Draw the storyboard of a plan into a PNG, SVG or PDF, by the suffix of ``output`` (see
+    the module docstring)."""
     data = storyboard_data(
         problem,
         actions,

@@ -164,7 +164,7 @@ def write_text_atomic(path: Path, text: str) -> Path:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as handle:
             handle.write(text)
-            os.fchmod(handle.fileno(), 0o666 & ~_umask())
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -173,7 +173,8 @@ def write_text_atomic(path: Path, text: str) -> Path:
 
 
 def _umask() -> int:
-    # the only way to read the umask is to set it; set it straight back
+    # the only portable way to read the umask is to set it; set it straight back (a file
+    # another thread creates in between gets 0o022, the common default)
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
