@@ -25,8 +25,10 @@ Backends
   one executor per process and hands the same one to every caller that asks with the same
   arguments, so only the first batch pays the pool's start-up (the workers' imports dominate
   it); the particle semantics (and through it the fixture repair) and the rollouts share it; it
-  is the process's only worker pool. Idle workers are
-  reaped after :data:`IDLE_TIMEOUT` seconds and respawned by the next batch. Interrupting a
+  is the process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
+  seconds and respawned by the next batch. Each worker watches its parent
+  (:func:`_end_with_parent`) and ends within :data:`PARENT_POLL` seconds of the parent's
+  death, even a SIGKILL that gives the parent no chance to stop its pool. Interrupting a
   batch cancels its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
   executor wrapper cannot take over an executor that ``get_reusable_executor`` created, so
   mixing the two in one process fails with ``AttributeError: _temp_folder_manager``.)
@@ -53,6 +55,7 @@ import logging
 import math
 import os
 import threading
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, wait
 from itertools import islice
@@ -150,14 +153,45 @@ class SerialRunner(Runner):
 IDLE_TIMEOUT = 10
 
 
+#: Seconds between a local worker's checks that the process that started it is alive.
+PARENT_POLL = 0.5
+
+
+def _end_with_parent(parent: int) -> None:
+    """Worker initializer: end this worker as soon as process ``parent`` (the one whose pool
+    it serves) is gone.
+
+    A killed parent cannot stop its pool, and loky's workers would otherwise live on until
+    their idle timeout or longer, holding cores. An orphan is adopted by another process, so
+    its parent pid changes: a daemon thread polls ``os.getppid()`` (POSIX; a portable test,
+    unlike Linux's ``PR_SET_PDEATHSIG``, which fires when the *thread* that started the
+    worker ends, and loky starts workers from its own threads too).
+    """
+    if os.getppid() != parent:  # started through an intermediate process: nothing to watch
+        return
+    threading.Thread(target=_watch_parent, args=(parent,), name="parent-watch", daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL)
+    os._exit(1)  # no cleanup to run: the results have nobody left to go to
+
+
 def local_executor(workers: int) -> Any:
     """The process's shared loky executor with ``workers`` processes (started on first use,
-    reused afterwards; resized, not restarted, when the count changes)."""
+    reused afterwards; resized, not restarted, when the count changes). Its workers end when
+    this process does, however it ends (see :func:`_end_with_parent`)."""
     # lazy: joblib's import is a start-up cost (docs/design/repair.md) that commands which
     # never start a pool must not pay
     from joblib.externals.loky import get_reusable_executor
 
-    return get_reusable_executor(max_workers=workers, timeout=IDLE_TIMEOUT)
+    return get_reusable_executor(
+        max_workers=workers,
+        timeout=IDLE_TIMEOUT,
+        initializer=_end_with_parent,
+        initargs=(os.getpid(),),
+    )
 
 
 class LocalRunner(Runner):

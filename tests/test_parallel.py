@@ -118,3 +118,55 @@ def test_dask_local_cluster_matches_local_processes():
     local = evaluate_plan(problem, actions, rollouts=20, seed=0, workers=2)
     assert on_dask == local
     assert on_dask.backend == "dask" and on_dask.workers == 2
+
+
+_ORPHANS = """
+import os, sys, time
+from arrange_up.parallel import LocalRunner
+from tests.test_parallel import _pid
+pids = {pid for _, pid in LocalRunner(2).map(_pid, range(40), chunksize=1)}
+print(" ".join(map(str, sorted(pids))), flush=True)
+time.sleep(60)
+"""
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie nobody reaps counts as ended)."""
+    try:
+        with open(f"/proc/{pid}/stat") as handle:
+            return handle.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+    except OSError:  # pragma: no cover - no /proc: ask the kernel
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        return True
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="orphans keep their parent pid on Windows")
+def test_workers_end_when_their_parent_is_killed():
+    # a SIGKILLed parent cannot stop its pool; its workers lived on for tens of seconds
+    import signal
+    import subprocess
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]),
+    }
+    parent = subprocess.Popen(
+        [sys.executable, "-c", _ORPHANS], stdout=subprocess.PIPE, text=True, cwd=root, env=env
+    )
+    try:
+        workers = [int(pid) for pid in parent.stdout.readline().split()]
+        assert len(workers) == 2 and all(_alive(pid) for pid in workers)
+    finally:
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+    deadline = time.monotonic() + 5.0
+    while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(pid) for pid in workers)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from arrange_up.cli.shared import comma_integers, comma_separated, fail, library_default
+from arrange_up.cli.shared import SEED, comma_integers, comma_separated, library_default
 from arrange_up.physics.bench import bench_physics
 
 
@@ -28,15 +28,13 @@ def bench() -> None:
     show_default=True,
     help="Comma-separated process counts to measure.",
 )
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=SEED, default=0, show_default=True)
 def bench_physics_command(pushes: int, workers: str, seed: int) -> None:
     """Push rollouts per second: 1 block, a 3-block and a 7-block chain against a wall.
 
     Each push is a full place-to-rest simulation in a fresh space at dt 1/240 s.
     """
     counts = tuple(comma_integers("--workers", workers))
-    if not counts or any(c < 1 for c in counts):
-        fail("--workers: counts must be at least 1")
     rows = bench_physics(
         n_pushes=pushes, workers=counts, seed=seed, progress=lambda msg: click.echo(msg, err=True)
     )

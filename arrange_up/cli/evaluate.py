@@ -15,6 +15,8 @@ from rich.progress import (
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
+    SEED,
+    OutputFile,
     backend_choice,
     echo_json,
     fail,
@@ -99,7 +101,7 @@ def _failure_lines(
 )
 @click.option(
     "--seed",
-    type=click.IntRange(0, None),
+    type=SEED,
     default=0,
     show_default=True,
     help="Rollout i draws its noise from (seed, i): equal seeds give equal results.",
@@ -107,7 +109,7 @@ def _failure_lines(
 @parallel_options("rollouts")
 @click.option(
     "--record",
-    type=click.Path(dir_okay=False),
+    type=OutputFile(),
     default=None,
     help="Append every rollout to this .jsonl file as it finishes; re-running with the same "
     "file resumes the evaluation.",

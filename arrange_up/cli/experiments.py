@@ -19,6 +19,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsed
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
+    FiniteFloat,
+    OutputDir,
     backend_choice,
     check_semantics,
     comma_integers,
@@ -204,7 +206,7 @@ def _refuse_bad_problems(names: list[str]) -> None:
 )
 @click.option(
     "--timeout",
-    type=click.FloatRange(0, None, min_open=True),
+    type=FiniteFloat(0, None, min_open=True),
     default=None,
     help="Planning time limit per run, seconds.",
 )
@@ -214,9 +216,7 @@ def _refuse_bad_problems(names: list[str]) -> None:
     default=None,
     help="Worker processes (default: all cores).",
 )
-@click.option(
-    "--output-dir", type=click.Path(file_okay=False), default="results", show_default=True
-)
+@click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
 def experiment_transition_comparison(
     problems: str,
     particle_counts: str,
@@ -290,20 +290,18 @@ def experiment_transition_comparison(
 )
 @click.option(
     "--weight",
-    type=click.FloatRange(0, None),
+    type=FiniteFloat(0, None),
     default=library_default(search_table, "weight"),
     show_default=True,
     help="1 = A*, as in the thesis's table.",
 )
 @click.option(
     "--timeout",
-    type=click.FloatRange(0, None, min_open=True),
+    type=FiniteFloat(0, None, min_open=True),
     default=None,
     help="Time limit per search, seconds.",
 )
-@click.option(
-    "--output-dir", type=click.Path(file_okay=False), default="results", show_default=True
-)
+@click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
 def experiment_search_table(
     problems: str,
     semantics: str | None,
@@ -389,7 +387,7 @@ def experiment_search_table(
 )
 @click.option(
     "--timeout",
-    type=click.FloatRange(0, None, min_open=True),
+    type=FiniteFloat(0, None, min_open=True),
     default=None,
     help="Time limit per repair, seconds (the thesis allowed 24 hours); a repair that reaches "
     "it is recorded with status 'timeout'.",
@@ -397,7 +395,7 @@ def experiment_search_table(
 @parallel_options("rollouts")
 @click.option(
     "--output-dir",
-    type=click.Path(file_okay=False),
+    type=OutputDir(),
     default="results",
     show_default=True,
     help="Where fixtures.csv and the PNGs go; a fixtures.csv already there is resumed.",

@@ -11,6 +11,9 @@ from rich.progress import TextColumn
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
+    SEED,
+    FiniteFloat,
+    OutputFile,
     actions_table,
     check_semantics,
     document_summary,
@@ -56,7 +59,7 @@ def _status_line(stats: dict[str, Any]) -> str:
 )
 @click.option(
     "--seed",
-    type=int,
+    type=SEED,
     default=0,
     show_default=True,
     help="Seed for initial particles and noise: equal seeds give equal plans.",
@@ -69,7 +72,7 @@ def _status_line(stats: dict[str, Any]) -> str:
 )
 @click.option(
     "--timeout",
-    type=click.FloatRange(0, None, min_open=True),
+    type=FiniteFloat(0, None, min_open=True),
     default=None,
     help="Give up after this many seconds.",
 )
@@ -82,7 +85,7 @@ def _status_line(stats: dict[str, Any]) -> str:
 )
 @click.option(
     "--weight",
-    type=click.FloatRange(0, None),
+    type=FiniteFloat(0, None),
     default=DEFAULT_WEIGHT,
     show_default=True,
     help="Weighted A*: f = g + weight * h (1 = A*).",
@@ -97,7 +100,7 @@ def _status_line(stats: dict[str, Any]) -> str:
 @click.option(
     "--output",
     "-o",
-    type=click.Path(dir_okay=False),
+    type=OutputFile(),
     default=None,
     help="Write the plan file (JSON, documented in docs/plan-format.md).",
 )

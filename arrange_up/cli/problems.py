@@ -6,13 +6,15 @@ from pathlib import Path
 
 import click
 
-from arrange_up.cli.shared import EXIT_NEGATIVE, fail, load_problem
-from arrange_up.io.domains import list_domains
-from arrange_up.io.pddl import PddlExportError, load_pddl_problem, write_pddl_problem
+from arrange_up.cli.shared import EXIT_NEGATIVE, OutputFile, fail, load_problem
+from arrange_up.io.domains import (
+    UnknownDomainError,
+    check_problem_file,
+    list_domains,
+    resolve_problem,
+)
+from arrange_up.io.pddl import PddlExportError, write_pddl_problem
 from arrange_up.io.planfile import write_text_atomic
-from arrange_up.io.yaml_problem import check_problem
-from arrange_up.model.errors import Diagnostic, ProblemFormatError
-from arrange_up.model.problem import ArrangementProblem
 
 
 @click.command()
@@ -26,47 +28,58 @@ def domains() -> None:
         )
 
 
-def _check_file(file: str) -> tuple[ArrangementProblem | None, list[Diagnostic]]:
-    """The problem of a .yaml or .pddl file (None if it has errors) and its diagnostics."""
-    if Path(file).suffix.lower() != ".pddl":
-        return check_problem(file)
+def _resolve(argument: str) -> tuple[Path | None, str | None]:
+    """The file a ``check`` argument names (a path, or a shipped problem's name), or why
+    there is none."""
     try:
-        return load_pddl_problem(file), []
-    except ProblemFormatError as error:
-        return None, list(error.diagnostics)
+        return resolve_problem(argument), None
+    except UnknownDomainError as error:
+        return None, str(error)
 
 
 @click.command()
-@click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("files", nargs=-1, required=True)
 @click.option("--quiet", "-q", is_flag=True, help="Print only errors and warnings.")
 def check(files: tuple[str, ...], quiet: bool) -> None:
     """Validate problem FILES (.yaml, or .pddl of the arrange-up domain).
 
-    Every problem in every file is reported at once, as FILE:LINE:COL: severity: key.path:
-    message. Exits 1 if any file has errors, 0 otherwise (warnings do not fail).
+    FILES are paths or shipped problems' names, as PROBLEM everywhere else. Every problem in
+    every file is reported at once, as FILE:LINE:COL: severity: key.path: message; a file that
+    cannot be read (or a folder) is reported and the others still checked. Two files of one
+    folder may not hold problems of the same name, except a problem's YAML and PDDL twins
+    (same file name, other suffix). Exits 1 if any file has errors, 0 otherwise (warnings do
+    not fail).
     """
     failed = 0
-    names: dict[tuple[Path, str], str] = {}
-    for file in files:
-        problem, diagnostics = _check_file(file)
+    names: dict[tuple[Path, str], Path] = {}
+    for argument in files:
+        path, reason = _resolve(argument)
+        if path is None:
+            click.echo(f"{argument}: error: {reason}", err=True)
+            failed += 1
+            continue
+        shown = argument if Path(argument).expanduser().is_file() else str(path)
+        problem, diagnostics = check_problem_file(path)
         for diagnostic in diagnostics:
             click.echo(str(diagnostic), err=True)
         if problem is None:
             failed += 1
             continue
-        key = (Path(file).resolve().parent, problem.name)
-        if key in names:
+        key = (path.resolve().parent, problem.name)
+        other = names.get(key)
+        if other is not None and other.stem != path.stem:
             click.echo(
-                f"{file}: error: name: problem name {problem.name!r} is already used by "
-                f"{names[key]} in the same folder; names must be unique within a folder",
+                f"{shown}: error: name: problem name {problem.name!r} is already used by "
+                f"{other} in the same folder; names must be unique within a folder (a "
+                "problem's YAML and PDDL twins share a file name)",
                 err=True,
             )
             failed += 1
             continue
-        names[key] = file
+        names.setdefault(key, path)
         if not quiet:
             click.echo(
-                f"{file}: ok: {problem.name} ({len(problem.parts)} parts, "
+                f"{shown}: ok: {problem.name} ({len(problem.parts)} parts, "
                 f"{'relative' if problem.goal.is_relative else 'absolute'} goal)"
             )
     if failed:
@@ -86,7 +99,7 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
 @click.option(
     "--output",
     "-o",
-    type=click.Path(dir_okay=False, writable=True),
+    type=OutputFile(),
     required=True,
     help="Where to write the problem.",
 )

@@ -10,6 +10,8 @@ import click
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
+    SEED,
+    OutputFile,
     actions_table,
     document_summary,
     echo_json,
@@ -87,7 +89,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
 )
 @click.option(
     "--seed",
-    type=int,
+    type=SEED,
     default=0,
     show_default=True,
     help="Seed for the particles, the noise and the nominal plan: equal seeds, equal plans.",
@@ -109,7 +111,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
 @click.option(
     "--output",
     "-o",
-    type=click.Path(dir_okay=False),
+    type=OutputFile(),
     default=None,
     help="Write the repaired plan file (JSON; semantics 'fixtures', per-step choices under "
     "'repair').",

@@ -1,6 +1,8 @@
-"""What every command of ``arrange-up`` shares: exit statuses, the clean failure, loading a
-problem or a plan file, the semantics check, the parallel options, the progress display, JSON
-and table output, and the library defaults the options show.
+"""What every command of ``arrange-up`` shares: exit statuses, the clean failure, the option
+types that validate values before any work (:data:`SEED`, :class:`FiniteFloat`,
+:class:`OutputFile`, ...), loading a problem (with its warnings) or a plan file, the semantics
+check, the parallel options, the progress display, JSON and table output, and the library
+defaults the options show.
 
 Exit status: 0 success; 1 the job ran but its answer is negative (e.g. a problem file has
 errors under ``check``); 2 bad input (unreadable or invalid problem, unknown domain, bad option).
@@ -10,16 +12,20 @@ from __future__ import annotations
 
 import inspect
 import json
+import math
+import os
 import sys
+import tempfile
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any, NoReturn
 
 import click
 from rich.console import Console
 from rich.progress import Progress, ProgressColumn
 
-from arrange_up.io.domains import UnknownDomainError, load
+from arrange_up.io.domains import UnknownDomainError, load_checked
 from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_mismatch, read_plan
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import ArrangementProblem
@@ -37,6 +43,86 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
     sys.exit(code)
 
 
+#: A seed: a non-negative integer (numpy's seed sequences refuse negative ones).
+SEED = click.IntRange(0, None)
+
+
+class FiniteFloat(click.FloatRange):
+    """A float option within bounds (as :class:`click.FloatRange`) that is also finite:
+    ``nan`` and ``inf`` are refused, they would pass every comparison or none."""
+
+    name = "finite float"
+
+    def convert(self, value: Any, param: Any, ctx: Any) -> Any:
+        number = click.FLOAT.convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return super().convert(number, param, ctx)
+
+
+class OutputFile(click.Path):
+    """A file the command will write, checked before any work: not a directory, in a folder
+    that exists or can be made and that a file can be created in, with one of ``suffixes``
+    (any when empty, matched case-insensitively)."""
+
+    name = "output file"
+
+    def __init__(self, suffixes: Sequence[str] = ()) -> None:
+        super().__init__(dir_okay=False)
+        self.suffixes = tuple(suffix.lower() for suffix in suffixes)
+
+    def convert(self, value: Any, param: Any, ctx: Any) -> Any:
+        text = super().convert(value, param, ctx)
+        path = Path(os.fsdecode(text))
+        if self.suffixes and path.suffix.lower() not in self.suffixes:
+            self.fail(
+                f"{text!r} has the suffix {path.suffix or '(none)'!r}; expected one of "
+                f"{', '.join(self.suffixes)}",
+                param,
+                ctx,
+            )
+        problem = unwritable(path)
+        if problem is not None:
+            self.fail(f"cannot write {text!r}: {problem}", param, ctx)
+        return text
+
+
+class OutputDir(click.Path):
+    """A folder the command will write files into, checked before any work: not a file,
+    existing or creatable, and a file can be created in it."""
+
+    name = "output folder"
+
+    def __init__(self) -> None:
+        super().__init__(file_okay=False)
+
+    def convert(self, value: Any, param: Any, ctx: Any) -> Any:
+        text = super().convert(value, param, ctx)
+        problem = unwritable(Path(os.fsdecode(text)) / "file")
+        if problem is not None:
+            self.fail(f"cannot write into {text!r}: {problem}", param, ctx)
+        return text
+
+
+def unwritable(path: Path) -> str | None:
+    """Why no file can be written at ``path``, or ``None``: a file is created (and removed)
+    in the nearest existing folder, since permissions alone do not tell (a read-only file
+    system, a process running as root)."""
+    folder = path.parent
+    while not folder.exists():
+        if folder.is_symlink():
+            return f"{folder} is a broken link"
+        folder = folder.parent
+    if not folder.is_dir():
+        return f"{folder} is not a folder"
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as error:
+        return f"no file can be created in {folder} ({error.strerror or error})"
+    return None
+
+
 def library_default(function: Callable[..., Any], parameter: str) -> Any:
     """The default of ``function``'s ``parameter``: an option whose default is the library's
     shows and uses that one, so the two cannot drift apart."""
@@ -49,23 +135,34 @@ def comma_separated(values: Sequence[Any]) -> str:
 
 
 def comma_integers(option: str, text: str) -> list[int]:
-    """The integers of a comma-separated option value (blank items skipped), exit 2 otherwise."""
+    """The positive integers of a comma-separated option value (blank items skipped; at least
+    one), exit 2 otherwise (every option of this kind counts things: particles, workers)."""
     try:
-        return [int(item) for item in text.split(",") if item.strip()]
+        values = [int(item) for item in text.split(",") if item.strip()]
     except ValueError:
         fail(f"{option}: expected comma-separated integers, got {text!r}")
+    if not values or any(value < 1 for value in values):
+        fail(f"{option}: expected comma-separated positive integers, got {text!r}")
+    return values
 
 
 def load_problem(problem: str) -> ArrangementProblem:
-    """Resolve and load a problem, turning every refusal into a clean message and exit 2."""
+    """Resolve and load a problem, turning every refusal into a clean message and exit 2.
+
+    The warnings found in the file (an unknown key, a default tolerance, ...) are printed on
+    stderr, as ``check`` prints them: every command that loads a problem goes through here.
+    """
     try:
-        return load(problem)
+        loaded, diagnostics = load_checked(problem)
     except UnknownDomainError as error:
         fail(str(error))
     except ProblemFormatError as error:
         click.echo(str(error), err=True)
         n = sum(1 for d in error.diagnostics if d.severity == "error")
         fail(f"{n} error{'s' if n != 1 else ''}; nothing was done")
+    for diagnostic in diagnostics:
+        click.echo(str(diagnostic), err=True)
+    return loaded
 
 
 def read_plan_file(

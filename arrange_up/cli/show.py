@@ -12,6 +12,8 @@ import click
 from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
 from arrange_up.cli.shared import (
+    SEED,
+    OutputFile,
     fail,
     library_default,
     load_problem,
@@ -19,6 +21,7 @@ from arrange_up.cli.shared import (
     terminal_progress,
 )
 from arrange_up.figures.animation import WriterUnavailableError, animate_plan, check_writer
+from arrange_up.figures.backend import FIGURE_SUFFIXES
 from arrange_up.figures.render import draw_problem, write_heatmap
 from arrange_up.figures.storyboard import draw_storyboard
 from arrange_up.parallel import available_cores
@@ -32,9 +35,9 @@ from arrange_up.transitions import available
 @click.option(
     "--output",
     "-o",
-    type=click.Path(dir_okay=False, writable=True),
+    type=OutputFile(FIGURE_SUFFIXES),
     default=None,
-    help="Where to write the picture (.png); with --plan, the storyboard.",
+    help="Where to write the picture (.png, .svg or .pdf); with --plan, the storyboard.",
 )
 @click.option(
     "--dpi",
@@ -80,7 +83,7 @@ from arrange_up.transitions import available
 )
 @click.option(
     "--seed",
-    type=int,
+    type=SEED,
     default=0,
     show_default=True,
     help="Seed of the storyboard's rollouts (as in `evaluate`).",

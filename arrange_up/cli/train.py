@@ -16,6 +16,9 @@ from arrange_up.cbst.features import TARGET_NAMES, TARGET_UNITS
 from arrange_up.cbst.model import train_cbst as run_training
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
+    SEED,
+    OutputDir,
+    OutputFile,
     backend_choice,
     echo_json,
     fail,
@@ -47,7 +50,7 @@ _STAGE_LABELS = {"data": "examples", "fit": "grid search"}
 )
 @click.option(
     "--seed",
-    type=click.IntRange(0, None),
+    type=SEED,
     default=0,
     show_default=True,
     help="Example i depends only on (seed, i); also seeds the split and the forest.",
@@ -55,7 +58,7 @@ _STAGE_LABELS = {"data": "examples", "fit": "grid search"}
 @parallel_options("examples")
 @click.option(
     "--output-dir",
-    type=click.Path(file_okay=False),
+    type=OutputDir(),
     default="cbst-model",
     show_default=True,
     help="Where NAME.npz and NAME.json go (semantics/cbst ships the default).",
@@ -69,7 +72,7 @@ _STAGE_LABELS = {"data": "examples", "fit": "grid search"}
 @click.option(
     "--data",
     "data_path",
-    type=click.Path(dir_okay=False),
+    type=OutputFile(),
     default=None,
     help="Resumable .jsonl data file (default OUTPUT_DIR/NAME.data.jsonl).",
 )

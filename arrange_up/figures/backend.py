@@ -7,12 +7,16 @@ draw.
 
 from __future__ import annotations
 
+from pathlib import Path
 from types import ModuleType
 
 import matplotlib
 import matplotlib.pyplot
 
-__all__ = ["pyplot"]
+__all__ = ["FIGURE_SUFFIXES", "figure_format", "pyplot"]
+
+#: Picture formats a figure is saved in, by the suffix of its file.
+FIGURE_SUFFIXES: dict[str, str] = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
 
 def pyplot() -> ModuleType:
@@ -20,3 +24,15 @@ def pyplot() -> ModuleType:
     opened; figures are saved and closed by their callers)."""
     matplotlib.use("Agg", force=False)
     return matplotlib.pyplot
+
+
+def figure_format(path: str | Path) -> str:
+    """The format a figure saved at ``path`` is written in, named by its suffix (case
+    ignored): a file called ``x.svg`` holds an SVG. Raises ``ValueError`` for other suffixes."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in FIGURE_SUFFIXES:
+        raise ValueError(
+            f"{path}: cannot draw a picture in format {suffix or '(no suffix)'!r}; expected a "
+            f"file name ending in {', '.join(FIGURE_SUFFIXES)}"
+        )
+    return FIGURE_SUFFIXES[suffix]

@@ -1,8 +1,8 @@
 """Pictures of problems: the table, the initial belief and the goal, like thesis Figures 2-8/2-9.
 
-:func:`draw_problem` writes one PNG of a whole problem. It is built from one helper per layer,
-each drawing onto a given matplotlib ``Axes`` so that other pictures (a storyboard with one
-panel per plan action, a report) can reuse them:
+:func:`draw_problem` writes one picture (PNG, SVG or PDF) of a whole problem. It is built from
+one helper per layer, each drawing onto a given matplotlib ``Axes`` so that other pictures (a
+storyboard with one panel per plan action, a report) can reuse them:
 
 * :func:`draw_table`: the table surface, its walls (thick dark bars on their edges) and the
   fixed obstacles (solid grey).
@@ -36,7 +36,7 @@ from matplotlib.patches import Patch, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
 from shapely.geometry import Polygon
 
-from arrange_up.figures.backend import pyplot
+from arrange_up.figures.backend import figure_format, pyplot
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.se2 import compose, rotate
 from arrange_up.io.domains import first_sentence
@@ -617,7 +617,8 @@ def draw_problem(
     title: str | None = None,
     dpi: int = 150,
 ) -> Path:
-    """Draw ``problem`` and save it as a PNG at ``output``; returns the path written.
+    """Draw ``problem`` and save it at ``output`` in the format its suffix names (PNG, SVG or
+    PDF: :func:`~arrange_up.figures.backend.figure_format`); returns the path written.
 
     The picture shows the table with its walls and obstacles, every object on the table at its
     nominal initial pose (filled, labelled) with its belief shadows, and the goal: for an
@@ -632,7 +633,7 @@ def draw_problem(
         output.parent.mkdir(parents=True, exist_ok=True)
     fig = problem_figure(problem, title=title)
     try:
-        fig.savefig(output, dpi=dpi, bbox_inches="tight", format="png")
+        fig.savefig(output, dpi=dpi, bbox_inches="tight", format=figure_format(output))
     finally:
         plt.close(fig)
     return output
@@ -883,14 +884,15 @@ def write_heatmap(
     title: str | None = None,
     **kwargs: Any,
 ) -> Path:
-    """Save :func:`heatmap_figure` of ``scores`` as a PNG at ``output``; returns the path."""
+    """Save :func:`heatmap_figure` of ``scores`` at ``output`` (PNG, SVG or PDF, by its
+    suffix); returns the path."""
     plt = pyplot()
     output = Path(output)
     if output.parent != Path(""):
         output.parent.mkdir(parents=True, exist_ok=True)
     fig = heatmap_figure(problem, scores, title=title, **kwargs)
     try:
-        fig.savefig(output, dpi=dpi, bbox_inches="tight", format="png")
+        fig.savefig(output, dpi=dpi, bbox_inches="tight", format=figure_format(output))
     finally:
         plt.close(fig)
     return output

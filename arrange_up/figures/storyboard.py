@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.evaluation.evaluate import trace_rollout
-from arrange_up.figures.backend import pyplot
+from arrange_up.figures.backend import figure_format, pyplot
 from arrange_up.figures.scene import (
     describe,
     draw_action,
@@ -103,7 +103,8 @@ def draw_storyboard(
     dpi: int = 110,
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
-    """Draw the storyboard of a plan into a PNG (see the module docstring).
+    """Draw the storyboard of a plan into a PNG, SVG or PDF, by the suffix of ``output`` (see
+    the module docstring).
 
     ``semantics``, ``particles`` and ``plan_seed`` are those the shadows are predicted with;
     ``plan_semantics`` is what the plan file records when it differs (e.g. ``fixtures`` for a
@@ -154,7 +155,7 @@ def draw_storyboard(
         fig.tight_layout(rect=(0, LEGEND_HEIGHT / fig.get_figheight(), 1, 1))
         output = Path(output)
         output.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(output, dpi=dpi)
+        fig.savefig(output, dpi=dpi, format=figure_format(output))
     finally:
         plt.close(fig)
     return output

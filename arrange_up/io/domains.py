@@ -26,20 +26,23 @@ from typing import Any
 
 from ruamel.yaml import YAML
 
-from arrange_up.io.pddl import load_pddl_problem
+from arrange_up.io.pddl_reader import check_pddl_problem
 from arrange_up.io.resources import shipped_dir
-from arrange_up.io.yaml_problem import load_problem
+from arrange_up.io.yaml_problem import check_problem
+from arrange_up.model.errors import Diagnostic, ProblemFormatError
 from arrange_up.model.problem import ArrangementProblem
 
 __all__ = [
     "PROBLEM_SUFFIXES",
     "DomainInfo",
     "UnknownDomainError",
+    "check_problem_file",
     "domain_names",
     "domains_dir",
     "first_sentence",
     "list_domains",
     "load",
+    "load_checked",
     "resolve_problem",
 ]
 
@@ -257,16 +260,27 @@ def resolve_problem(name_or_path: str | Path) -> Path:
     raise UnknownDomainError(text, _suggest(base, names), tuple(names))
 
 
-def load_problem_file(path: str | Path) -> ArrangementProblem:
-    """Load a problem file by its suffix: ``.pddl`` through the PDDL front end, anything else
-    as YAML. Raises :class:`arrange_up.model.errors.ProblemFormatError`."""
+def check_problem_file(path: str | Path) -> tuple[ArrangementProblem | None, list[Diagnostic]]:
+    """Validate a problem file by its suffix (``.pddl`` through the PDDL front end, anything
+    else as YAML): ``(problem, diagnostics)``, ``problem`` being ``None`` when there is at
+    least one error; the diagnostics include the warnings. Never raises for a bad file."""
     if Path(path).suffix.lower() == ".pddl":
-        return load_pddl_problem(path)
-    return load_problem(path)
+        return check_pddl_problem(path)
+    return check_problem(path)
 
 
-def load(name_or_path: str | Path) -> ArrangementProblem:
-    """Resolve ``name_or_path`` (see :func:`resolve_problem`) and load the problem.
+def load_problem_file(path: str | Path) -> ArrangementProblem:
+    """Load a problem file by its suffix (see :func:`check_problem_file`). Raises
+    :class:`arrange_up.model.errors.ProblemFormatError`."""
+    problem, diagnostics = check_problem_file(path)
+    if problem is None:
+        raise ProblemFormatError(diagnostics)
+    return problem
+
+
+def load_checked(name_or_path: str | Path) -> tuple[ArrangementProblem, list[Diagnostic]]:
+    """Resolve ``name_or_path`` (see :func:`resolve_problem`) and load the problem, with the
+    warnings found in its file (the loaders never refuse a file for warnings alone).
 
     A shipped problem loaded by name records ``source="domain:NAME"``.
 
@@ -275,7 +289,14 @@ def load(name_or_path: str | Path) -> ArrangementProblem:
         arrange_up.model.errors.ProblemFormatError: the file is not a valid problem.
     """
     path = resolve_problem(name_or_path)
-    problem = load_problem_file(path)
+    problem, diagnostics = check_problem_file(path)
+    if problem is None:
+        raise ProblemFormatError(diagnostics)
     if not Path(str(name_or_path)).expanduser().is_file():
         problem = dataclasses.replace(problem, source=f"domain:{path.stem}")
-    return problem
+    return problem, diagnostics
+
+
+def load(name_or_path: str | Path) -> ArrangementProblem:
+    """:func:`load_checked` without the warnings."""
+    return load_checked(name_or_path)[0]

@@ -59,13 +59,21 @@ gathers their public functions.
 from __future__ import annotations
 
 from arrange_up.io.pddl_domain import DOMAIN_FILE, DOMAIN_NAME, domain_path, domain_pddl_text
-from arrange_up.io.pddl_reader import load_pddl_problem, load_pddl_problem_text, problem_from_up
+from arrange_up.io.pddl_reader import (
+    check_pddl_problem,
+    check_pddl_problem_text,
+    load_pddl_problem,
+    load_pddl_problem_text,
+    problem_from_up,
+)
 from arrange_up.io.pddl_writer import PddlExportError, write_pddl_problem
 
 __all__ = [
     "DOMAIN_FILE",
     "DOMAIN_NAME",
     "PddlExportError",
+    "check_pddl_problem",
+    "check_pddl_problem_text",
     "domain_path",
     "domain_pddl_text",
     "load_pddl_problem",

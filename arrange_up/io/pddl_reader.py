@@ -39,7 +39,15 @@ from arrange_up.model.problem import (
     Uncertainty,
 )
 
-__all__ = ["load_pddl_problem", "load_pddl_problem_text", "problem_from_up"]
+__all__ = [
+    "check_pddl_problem",
+    "check_pddl_problem_text",
+    "load_pddl_problem",
+    "load_pddl_problem_text",
+    "problem_from_up",
+]
+
+Checked = tuple[ArrangementProblem | None, list[Diagnostic]]
 
 
 def load_pddl_problem(path: str | Path, domain: str | Path | None = None) -> ArrangementProblem:
@@ -49,24 +57,68 @@ def load_pddl_problem(path: str | Path, domain: str | Path | None = None) -> Arr
     the line and column where they can (UP's reader reports little; the offending object or
     fluent is looked up in the text) and what was expected.
     """
-    source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise ProblemFormatError(
-            [Diagnostic(source, None, None, "", "no such file; expected a .pddl problem file")]
-        ) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise ProblemFormatError(
-            [Diagnostic(source, None, None, "", f"cannot read the file: {error}")]
-        ) from None
-    return load_pddl_problem_text(text, source, domain=domain)
+    return _loaded(check_pddl_problem(path, domain))
 
 
 def load_pddl_problem_text(
     text: str, source: str = "<text>", domain: str | Path | None = None
 ) -> ArrangementProblem:
     """Like :func:`load_pddl_problem`, for PDDL ``text`` named ``source`` in messages."""
+    return _loaded(check_pddl_problem_text(text, source, domain))
+
+
+def _loaded(checked: Checked) -> ArrangementProblem:
+    problem, diagnostics = checked
+    if problem is None:
+        raise ProblemFormatError(diagnostics)
+    return problem
+
+
+def check_pddl_problem(path: str | Path, domain: str | Path | None = None) -> Checked:
+    """Validate a ``.pddl`` problem file: ``(problem, diagnostics)``, ``problem`` being ``None``
+    when there is at least one error; the diagnostics include the warnings. Never raises for a
+    bad file."""
+    source = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        return None, [Diagnostic(source, None, None, "", "no such file; expected a .pddl file")]
+    except IsADirectoryError:
+        return None, [Diagnostic(source, None, None, "", "is a directory; expected a .pddl file")]
+    except OSError as error:
+        message = f"cannot read the file: {error.strerror or error}"
+        return None, [Diagnostic(source, None, None, "", message)]
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        before = data[: error.start]
+        line = before.count(b"\n") + 1
+        column = len(before) - (before.rfind(b"\n") + 1) + 1
+        message = (
+            f"not a text file: byte 0x{data[error.start]:02x} is not UTF-8; expected a PDDL "
+            "problem file in UTF-8"
+        )
+        return None, [Diagnostic(source, line, column, "", message)]
+    return check_pddl_problem_text(text, source, domain)
+
+
+def check_pddl_problem_text(
+    text: str, source: str = "<text>", domain: str | Path | None = None
+) -> Checked:
+    """Like :func:`check_pddl_problem`, for PDDL ``text`` named ``source`` in messages."""
+    try:
+        return _check_text(text, source, domain)
+    except ProblemFormatError as error:
+        return None, list(error.diagnostics)
+    except Exception as error:  # a safety net: a bug here must not become a traceback
+        message = (
+            f"internal error while checking the file ({type(error).__name__}: {error}); "
+            "please report this"
+        )
+        return None, [Diagnostic(source, None, None, "", message)]
+
+
+def _check_text(text: str, source: str, domain: str | Path | None) -> Checked:
     # Lazy: unified-planning is slow to import (docs/design/io.md) and io.domains imports this
     # module, so loading a YAML problem by name would pay for it otherwise.
     from unified_planning.io import PDDLReader
@@ -93,7 +145,9 @@ def load_pddl_problem_text(
         up_problem = PDDLReader().parse_problem_string(domain_text, text)
     except Exception as error:  # UP raises many kinds; each becomes one diagnostic
         raise ProblemFormatError([_reader_diagnostic(error, source, located)]) from None
-    return problem_from_up(up_problem, source=source, text=text)
+    builder = _Builder(up_problem, source, located)
+    problem = builder.build()
+    return problem, sort_diagnostics(builder.diagnostics)
 
 
 def problem_from_up(
@@ -178,6 +232,15 @@ class _Text:
 def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnostic:
     line = column = None
     message = str(error).strip() or type(error).__name__
+    if isinstance(error, RecursionError):
+        return Diagnostic(
+            source,
+            None,
+            None,
+            "",
+            "not valid PDDL: nested too deeply; expected a (define (problem ...)) of the "
+            f"{DOMAIN_NAME} domain",
+        )
     if hasattr(error, "lineno") and hasattr(error, "col"):  # pyparsing's ParseException
         line, column = int(error.lineno), int(error.col)
         message = f"not valid PDDL: {getattr(error, 'msg', message)}"
@@ -186,7 +249,7 @@ def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnos
         line, column = located.find(rf"(?<![\w-]){re.escape(name)}(?![\w-])")
         message = (
             f"unknown name {name!r}: not a type, function or object of the {DOMAIN_NAME} "
-            f"domain ({DOMAIN_FILE}); object types must be shape types of "
+            f"domain ({DOMAIN_FILE}); expected object types among the shape types of "
             f"{load_catalogue().path} ({', '.join(load_catalogue().type_names)})"
         )
     else:
@@ -227,6 +290,8 @@ class _Builder:
     def build(self) -> ArrangementProblem | None:
         kinds, objects = self.objects()
         values = self.initial_values(kinds)
+        if any(d.is_error for d in self.diagnostics):
+            return None  # numbers that are not doubles would fail every later check
         table = self.table(values)
         uncertainty = self.uncertainty(values)
         initial, obstacles = self.poses(values, kinds)
@@ -253,7 +318,20 @@ class _Builder:
             source=self.source,
         )
         self.check_placement(problem)
-        return None if any(d.is_error for d in self.diagnostics) else problem
+        self.check_goal_on_table(problem)
+        if any(d.is_error for d in self.diagnostics):
+            return None
+        if validation.unsampleable(problem):
+            self.error(
+                "init",
+                r"\(\s*:init",
+                f"no collision-free initial state in {validation.SAMPLE_DRAWS} draws from the "
+                "initial uncertainties (dx, dy, dtheta): objects overlap each other, an "
+                "obstacle or a wall in every one; expected uncertainties from which particles "
+                "can be drawn",
+            )
+            return None
+        return problem
 
     # -- objects ---------------------------------------------------------------------------
     def objects(self) -> tuple[dict[str, ObjectKind], list[ObjectSpec]]:
@@ -287,9 +365,34 @@ class _Builder:
             key = (fluent_exp.fluent().name, *(self.name(a.object().name) for a in fluent_exp.args))
             if value.is_bool_constant():
                 out[key] = value.bool_constant_value()
-            else:
-                out[key] = Fraction(value.constant_value())
+                continue
+            number = Fraction(value.constant_value())
+            if self.finite(number, f"init.{key[0]}", _fluent_pattern(key)):
+                out[key] = number
         return out
+
+    def finite(self, number: Fraction, path: str, pattern: str) -> bool:
+        """Whether ``number`` is a usable double; reported at ``pattern`` when it is not."""
+        try:
+            float(number)
+        except OverflowError:
+            digits = len(str(abs(number.numerator) // number.denominator))
+            self.error(
+                path,
+                pattern,
+                f"a number of {digits} digits is too large; expected a finite number of at "
+                "most 1e308 (a double)",
+            )
+            return False
+        return True
+
+    def angle(self, path: str, pattern: str, degrees: Fraction) -> bool:
+        """Whether ``degrees`` is a usable angle (see :data:`validation.MAX_ANGLE`)."""
+        reason = validation.angle_problem(PDDL_UNITS.angle_in(float(degrees)))
+        if reason is not None:
+            self.error(path, pattern, f"angle {num(float(degrees))} deg: {reason}")
+            return False
+        return True
 
     def number(self, values: dict, key: tuple[str, ...], default: Fraction | None) -> Any:
         value = values.get(key, default)
@@ -329,12 +432,19 @@ class _Builder:
             value = values.get((name,))
             if value is None:
                 continue
-            if value < 0:
+            density = "density" in name  # a body of zero mass cannot be simulated
+            if value < 0 or (density and value == 0):
                 self.error(
                     f"init.{name}",
                     rf"\(\s*{name}\s*\)",
-                    f"({name}) is {num(float(value))}; expected a value >= 0",
+                    f"({name}) is {num(float(value))}; expected a value "
+                    f"{'> 0 (a density)' if density else '>= 0'}",
                 )
+                ok = False
+                continue
+            if name.endswith("dtheta") and not self.angle(
+                f"init.{name}", rf"\(\s*{name}\s*\)", value
+            ):
                 ok = False
                 continue
             fields[attr][index] = self.convert(name, value)
@@ -358,6 +468,15 @@ class _Builder:
                 ok = False
         if not ok:
             return None
+        if fields["friction"][1] > validation.MAX_FRICTION:
+            self.error(
+                "init.friction-max",
+                r"\(\s*friction-max\s*\)",
+                f"(friction-max) is {num(fields['friction'][1])}, far above real table-top "
+                f"materials (below ~1.5); every push will stick. Expected at most "
+                f"{num(validation.MAX_FRICTION)}: check the value",
+                severity="warning",
+            )
         return Uncertainty(**{attr: tuple(v) for attr, v in fields.items()})  # type: ignore[arg-type]
 
     @staticmethod
@@ -393,6 +512,10 @@ class _Builder:
                         f"(= (theta {name}) ...) in degrees",
                     )
                     break
+                if function == "theta" and not self.angle(
+                    f"init.theta({name})", rf"\(\s*theta\s+{re.escape(name)}\s*\)", value
+                ):
+                    break
                 pose.append(self.convert(function, value))
             if len(pose) != 3:
                 continue
@@ -407,6 +530,12 @@ class _Builder:
                         f"init.{function}({name})",
                         rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
                         f"({function} {name}) is {num(float(value))}; expected a half-width >= 0",
+                    )
+                elif function == "dtheta":
+                    self.angle(
+                        f"init.dtheta({name})",
+                        rf"\(\s*dtheta\s+{re.escape(name)}\s*\)",
+                        value,
                     )
                 spread.append(self.convert(function, value))
             initial.append(
@@ -519,7 +648,8 @@ class _Builder:
                         f"goal.{function}({part})",
                         rf"\(\s*{function}\s+{re.escape(part)}[\s)]",
                         f"({function} {part}) must lie in [{num(float(low))}, "
-                        f"{num(float(high))}], an empty interval",
+                        f"{num(float(high))}], an empty interval; expected the (>= ...) bound "
+                        "at most the (<= ...) bound",
                     )
                     ok = False
                     break
@@ -576,6 +706,13 @@ class _Builder:
             if fluent is not None and fluent.fluent().name in POSE_FUNCTIONS + RELATIVE_FUNCTIONS:
                 function = fluent.fluent().name
                 args = [self.name(a.object().name) for a in fluent.args]
+                pattern = rf"\(\s*{function}\s+{re.escape(args[0])}[\s)]"
+                if not self.finite(value, f"goal.{function}({args[0]})", pattern):
+                    return None
+                if function in ANGLE_FUNCTIONS and not self.angle(
+                    f"goal.{function}({args[0]})", pattern, value
+                ):
+                    return None
                 reference = args[1] if len(args) == 2 else None
                 if condition.is_equals():
                     return function, args[0], reference, value, value
@@ -589,6 +726,38 @@ class _Builder:
             "(<= (x P) hi) and likewise y, theta, or rel-x/rel-y/rel-theta of (P R)",
         )
         return None
+
+    def check_goal_on_table(self, problem: ArrangementProblem) -> None:
+        """An absolute goal whose part cannot be on the table is an error; one whose part
+        sticks out of the table at the target pose a warning."""
+        goal = problem.goal
+        if goal.is_relative:
+            return
+        width, depth = problem.table.size
+        for name, pose in goal.targets:
+            found = validation.goal_outside(
+                problem.object(name).shape, pose, goal.tolerance[:2], problem.table.size
+            )
+            if found is None:
+                continue
+            verdict, (xmin, ymin, xmax, ymax) = found
+            where = f"the table [0, {num(width)}] x [0, {num(depth)}] in"
+            if verdict == "unreachable":
+                self.error(
+                    f"goal.{name}",
+                    r"\(\s*:goal",
+                    f"the goal of {name} is off the table even within the tolerance (its "
+                    f"centroid must be on {where}); expected a goal interval on the table",
+                )
+            else:
+                self.error(
+                    f"goal.{name}",
+                    r"\(\s*:goal",
+                    f"at its goal pose {name} spans x {num(xmin)}..{num(xmax)}, y "
+                    f"{num(ymin)}..{num(ymax)}, beyond {where}: only poses within the "
+                    "tolerance that keep it on the table can meet the goal",
+                    severity="warning",
+                )
 
     # -- placement (the semantic checks of io.validation, shared with the YAML reader) --------
     def check_placement(self, problem: ArrangementProblem) -> None:
@@ -616,6 +785,11 @@ class _Builder:
                     f"{name} overlaps {placed[index].name} at their nominal poses (overlap area "
                     f"{num(overlap)} in²); expected shapes that touch at most",
                 )
+
+
+def _fluent_pattern(key: tuple[str, ...]) -> str:
+    """Where the value of fluent ``(function arg ...)`` is set in the text."""
+    return r"\(\s*" + r"\s+".join(re.escape(part) for part in key) + r"\s*\)"
 
 
 def _conjuncts(goals: Iterable[Any]) -> list[Any]:

@@ -34,8 +34,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from arrange_up.io.validation import angle_problem
+from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, problem_hash
-from arrange_up.model.units import Units
+from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
 from arrange_up.model.world import Action, Pick, Place, Push
 
 PLAN_FORMAT = "arrange-up-plan/1"
@@ -92,8 +94,12 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
             or len(pose) != 3
             or not all(_is_number(v) for v in pose)
         ):
-            raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {pose!r}")
-        return units.pose_in(tuple(pose))  # type: ignore[arg-type]
+            raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {_shown(pose)}")
+        internal = units.pose_in(tuple(pose))  # type: ignore[arg-type]
+        reason = angle_problem(internal[2])
+        if reason is not None:
+            raise PlanFileError(f"{where}.pose[2]: angle {pose[2]:g} {units.angle}: {reason}")
+        return internal
 
     movable = (ObjectKind.PART, ObjectKind.FIXTURE, ObjectKind.MANIPULATOR)
     if kind == "place":
@@ -102,14 +108,14 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
         distance = data.get("distance")
         if not _is_number(distance) or distance < 0:
             raise PlanFileError(
-                f"{where}.distance: expected a non-negative number, got {distance!r}"
+                f"{where}.distance: expected a non-negative number, got {_shown(distance)}"
             )
         return Push(
             name_of("manipulator", (ObjectKind.MANIPULATOR,)), pose_of(), units.length_in(distance)
         )
     if kind == "pick":
         return Pick(name_of("object", movable))
-    raise PlanFileError(f"{where}.type: expected 'place', 'push' or 'pick', got {kind!r}")
+    raise PlanFileError(f"{where}.type: expected 'place', 'push' or 'pick', got {_shown(kind)}")
 
 
 def plan_document(
@@ -150,13 +156,15 @@ def write_json_atomic(path: Path, document: Mapping[str, Any]) -> Path:
 
 def write_text_atomic(path: Path, text: str) -> Path:
     """Write ``text`` to ``path`` through a temporary file and a rename, so that a reader (or
-    a crash) never leaves a half-written file behind."""
+    a crash) never leaves a half-written file behind. The file gets the permissions of any
+    newly created file (``0o666`` less the umask), not the temporary file's private ``0o600``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as handle:
             handle.write(text)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -164,37 +172,128 @@ def write_text_atomic(path: Path, text: str) -> Path:
     return path
 
 
+def _umask() -> int:
+    # the only portable way to read the umask is to set it; set it straight back (a file
+    # another thread creates in between gets 0o022, the common default)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+#: How deeply a plan file's JSON may nest. A plan nests four levels; the limit keeps a
+#: hostile file from exhausting the parser's stack.
+MAX_DEPTH = 32
+
+
+def _read_document(path: Path) -> Any:
+    """The JSON value of a plan file, or :class:`PlanFileError` naming the place."""
+    try:
+        data = path.read_bytes()
+    except IsADirectoryError:
+        raise PlanFileError(f"{path}: is a directory; expected a plan file (JSON)") from None
+    except OSError as error:
+        raise PlanFileError(f"{path}: cannot read plan file: {error.strerror or error}") from None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        before = data[: error.start]
+        line = before.count(b"\n") + 1
+        column = len(before) - (before.rfind(b"\n") + 1) + 1
+        raise PlanFileError(
+            f"{path}:{line}:{column}: not a text file: byte 0x{data[error.start]:02x} is not "
+            "UTF-8; expected a plan file (JSON in UTF-8)"
+        ) from None
+    depth = _nesting(text)
+    if depth > MAX_DEPTH:
+        raise PlanFileError(
+            f"{path}: nested {depth} levels deep; expected a plan file (JSON nested at most "
+            f"{MAX_DEPTH} levels)"
+        )
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise PlanFileError(
+            f"{path}:{error.lineno}:{error.colno}: not JSON: {error.msg}; expected a plan "
+            "file (a JSON object)"
+        ) from None
+    except ValueError as error:  # an integer of more digits than Python converts
+        line, column, digits = long_number(text)
+        if not digits:
+            raise PlanFileError(f"{path}: not a plan file: {error}") from None
+        raise PlanFileError(
+            f"{path}:{line}:{column}: a number of {digits} digits; expected a finite number "
+            "(a double, at most about 1e308)"
+        ) from None
+
+
+def _nesting(text: str) -> int:
+    """How deeply the brackets of JSON ``text`` nest (brackets inside strings not counted)."""
+    depth = deepest = 0
+    in_string = escaped = False
+    for char in text:
+        if in_string:
+            if escaped:
+                escaped = False
+            elif char == "\\":
+                escaped = True
+            elif char == '"':
+                in_string = False
+        elif char == '"':
+            in_string = True
+        elif char in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif char in "]}":
+            depth -= 1
+    return deepest
+
+
 def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Action, ...], dict]:
     """Read a plan file for ``problem``; return its actions (internal units) and the document.
 
-    Raises :class:`PlanFileError` for unreadable files, other formats, unsolved plans and
-    actions that do not fit the problem.
+    Raises :class:`PlanFileError` for unreadable files (not UTF-8, not JSON, nested too
+    deeply), other formats, unsolved plans and actions that do not fit the problem (numbers
+    that are not finite doubles, angles too large to mean an orientation).
     """
     path = Path(path)
-    try:
-        document = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise PlanFileError(f"{path}: cannot read plan file: {error.strerror}") from None
-    except json.JSONDecodeError as error:
-        raise PlanFileError(f"{path}:{error.lineno}:{error.colno}: not JSON: {error.msg}") from None
-    if not isinstance(document, dict) or document.get("format") != PLAN_FORMAT:
+    document = _read_document(path)
+    if not isinstance(document, dict):
         raise PlanFileError(
-            f"{path}: format: expected {PLAN_FORMAT!r}, got "
-            f"{document.get('format') if isinstance(document, dict) else document!r}"
+            f'{path}: format: expected a plan file, a JSON object with "format": '
+            f"{PLAN_FORMAT!r}; got {_shown(document)} ({_json_kind(document)})"
+        )
+    if document.get("format") != PLAN_FORMAT:
+        raise PlanFileError(
+            f"{path}: format: expected {PLAN_FORMAT!r}, got {_shown(document.get('format'))}"
         )
     if document.get("status") != "solved" or "actions" not in document:
         raise PlanFileError(
-            f"{path}: status: the plan is {document.get('status')!r}, not "
-            "'solved'; it holds no actions to use"
+            f"{path}: status: the plan is {_shown(document.get('status'))}, not "
+            "'solved'; it holds no actions to use (expected a solved plan)"
         )
     raw_units = document.get("units", {})
-    try:
-        units = Units(raw_units.get("length", "in"), raw_units.get("angle", "deg"))
-    except (AttributeError, ValueError) as error:
-        raise PlanFileError(f"{path}: units: {error}") from None
+    if not isinstance(raw_units, dict):
+        raise PlanFileError(
+            f'{path}: units: expected an object {{"length": ..., "angle": ...}}, got '
+            f"{_json_kind(raw_units)}"
+        )
+    for key, table, default in (("length", LENGTH_UNITS, "in"), ("angle", ANGLE_UNITS, "deg")):
+        unit = raw_units.get(key, default)
+        if not isinstance(unit, str) or unit not in table:
+            raise PlanFileError(
+                f"{path}: units: unknown {key} unit {_shown(unit)}; expected one of "
+                f"{', '.join(table)}"
+            )
+    units = Units(raw_units.get("length", "in"), raw_units.get("angle", "deg"))
+    recorded = document.get("problem", {})
+    if not isinstance(recorded, dict):
+        raise PlanFileError(
+            f'{path}: problem: expected an object {{"name", "hash", "source"}} naming '
+            f"the problem the plan is for, got {_json_kind(recorded)}"
+        )
     raw_actions = document["actions"]
     if not isinstance(raw_actions, list):
-        raise PlanFileError(f"{path}: actions: expected a list")
+        raise PlanFileError(f"{path}: actions: expected a list, got {_json_kind(raw_actions)}")
     actions = tuple(
         action_from_json(item, units, problem, f"{path}: actions[{i}]")
         for i, item in enumerate(raw_actions)
@@ -205,6 +304,8 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
 def plan_problem_mismatch(document: Mapping[str, Any], problem: ArrangementProblem) -> str | None:
     """A warning if the plan ``document`` was made for a problem other than ``problem``."""
     recorded = document.get("problem", {}) if isinstance(document, Mapping) else {}
+    if not isinstance(recorded, Mapping):
+        return f"its 'problem' is {_json_kind(recorded)}, not an object naming the problem"
     if recorded.get("hash") not in (None, problem_hash(problem)):
         return (
             f"it was planned for problem {recorded.get('name')!r} with other content "
@@ -223,4 +324,34 @@ def _round(value: float) -> float:
 
 
 def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    """A finite number that converts to a double (a 400-digit integer does not)."""
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def _shown(value: Any) -> str:
+    """``value`` as a message quotes it, shortened (a plan file may hold anything)."""
+    try:
+        text = repr(value)
+    except ValueError:  # an integer too long to print
+        text = "a number of very many digits"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _json_kind(value: Any) -> str:
+    """What a JSON value is, for messages: ``a list``, ``the string 'x'``, ..."""
+    if isinstance(value, dict):
+        return "an object"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, str):
+        return f"the string {_shown(value)}"
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return f"{str(value).lower()} (a boolean)"
+    return f"the number {_shown(value)}"

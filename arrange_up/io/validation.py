@@ -8,30 +8,55 @@ units and points at the YAML node; the PDDL reader speaks inches and points at t
 
 :func:`check_placement` says, for each object placed at its nominal pose, whether its footprint
 lies outside the table and which objects placed before it it overlaps, and by how much;
-:func:`part_overlaps` which convex parts of one shape overlap (they may only touch).
+:func:`part_overlaps` which convex parts of one shape overlap (they may only touch);
+:func:`goal_outside` whether a goal pose can be met on the table; :func:`unsampleable` whether
+collision-free initial states can be drawn from the initial uncertainty at all.
+
+Plausibility bounds on numbers that are valid but meaningless are here too
+(:data:`MAX_ANGLE`, :data:`MAX_FRICTION`), so both readers and the plan file reader use the same.
 """
 
 from __future__ import annotations
 
+import math
+import random
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from arrange_up.geometry import shapes as geometry
-from arrange_up.model.problem import ConvexPolygon, Pose, Shape
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.problem import ArrangementProblem, ConvexPolygon, Pose, Shape
+from arrange_up.model.world import WorldState
 
 __all__ = [
     "AREA_TOLERANCE",
     "BOUNDS_TOLERANCE",
+    "MAX_ANGLE",
+    "MAX_FRICTION",
+    "SAMPLE_DRAWS",
     "Placed",
     "PlacementCheck",
+    "angle_problem",
     "check_placement",
+    "goal_outside",
     "part_overlaps",
+    "unsampleable",
 ]
 
 #: Overlap area (square inches) above which two shapes count as overlapping; touching is fine.
 AREA_TOLERANCE = 1e-9
 #: How far (inches) a footprint may stick out of the table and still count as inside.
 BOUNDS_TOLERANCE = 1e-9
+
+#: Largest angle magnitude (radians) accepted anywhere. Beyond it a double no longer resolves
+#: the angle to 1e-9 rad (its spacing there is 2**-28 rad), so the angle means nothing: 1e300
+#: degrees is refused rather than silently turned into some arbitrary orientation.
+MAX_ANGLE = 2.0**24
+#: Friction coefficients above this are warned about: real table-top materials stay below ~1.5
+#: (rubber on rubber), and far higher values make every push stick.
+MAX_FRICTION = 10.0
+#: Draws :func:`unsampleable` makes: the particle sampler gives up on a particle after as many.
+SAMPLE_DRAWS = 1000
 
 Bounds = tuple[float, float, float, float]
 
@@ -108,3 +133,65 @@ def part_overlaps(parts: Sequence[ConvexPolygon]) -> list[tuple[int, int, float]
             if area > AREA_TOLERANCE:
                 found.append((i, j, area))
     return found
+
+
+def angle_problem(value: float) -> str | None:
+    """Why the angle ``value`` (radians) is refused, or ``None`` when it is usable."""
+    if math.isfinite(value) and abs(value) <= MAX_ANGLE:
+        return None
+    return (
+        f"expected an angle of magnitude at most {MAX_ANGLE:g} rad (beyond it a double cannot "
+        "resolve the orientation; give the angle modulo a full turn)"
+    )
+
+
+def goal_outside(
+    shape: Shape, pose: Pose, tolerance: tuple[float, float], table_size: tuple[float, float]
+) -> tuple[str, Bounds] | None:
+    """Whether a part can meet an absolute goal ``pose`` (inches, radians) on the table.
+
+    ``("unreachable", bounds)`` when the centroid cannot be on the table within the x/y
+    ``tolerance`` (a part on the table has its centroid in the convex hull of its footprint,
+    hence on the table); ``("sticks out", bounds)`` when the footprint at the target pose is not
+    within the table (the goal may still be met by a pose within the tolerance); ``None`` when
+    the footprint at the target pose lies on the table. ``bounds`` is the footprint's
+    ``(xmin, ymin, xmax, ymax)`` at the target pose.
+    """
+    width, depth = table_size
+    x, y, _ = pose
+    dx, dy = tolerance
+    footprint = geometry.footprint(shape.parts, pose).bounds
+    if x + dx < 0 or y + dy < 0 or x - dx > width or y - dy > depth:
+        return "unreachable", footprint
+    xmin, ymin, xmax, ymax = footprint
+    tol = BOUNDS_TOLERANCE
+    if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
+        return "sticks out", footprint
+    return None
+
+
+def unsampleable(problem: ArrangementProblem, draws: int = SAMPLE_DRAWS) -> bool:
+    """True when none of ``draws`` initial states drawn uniformly from the initial intervals is
+    free of collisions (objects overlapping each other, an obstacle or a wall).
+
+    The particle sampler draws the same way and gives up on a particle after
+    :data:`SAMPLE_DRAWS` tries, so such a problem cannot be planned for. The draws are seeded
+    (the answer depends on the problem only) and stop at the first collision-free state, so a
+    problem with a sensible uncertainty costs one collision test. Problems whose nominal
+    placement is already refused are not asked about.
+    """
+    entries = [entry for entry in problem.initial if any(entry.uncertainty)]
+    if not entries:
+        return False
+    checker = CollisionChecker(problem)
+    rng = random.Random(0)
+    for _ in range(draws):
+        poses = {
+            entry.name: tuple(
+                entry.pose[k] + rng.uniform(-1.0, 1.0) * entry.uncertainty[k] for k in range(3)
+            )
+            for entry in problem.initial
+        }
+        if not checker.state_collides(WorldState.from_mapping(problem, poses)):
+            return False
+    return True

@@ -102,6 +102,9 @@ class ProblemBuilder(NodeReader):
         uncertainty = self.uncertainty(root)
         planning = self.planning(root)
 
+        if table is not None and goal is not None:
+            self.check_goal_on_table(root, table, objects, goal)
+
         if self.report.error_count:
             return None
         assert name is not None and table is not None and goal is not None
@@ -110,7 +113,7 @@ class ProblemBuilder(NodeReader):
             ObjectSpec(o.name, o.kind, o.shape, o.pose)  # type: ignore[arg-type]
             for o in objects.values()
         )
-        return ArrangementProblem(
+        problem = ArrangementProblem(
             name=name,
             table=table,
             objects=specs,
@@ -122,6 +125,53 @@ class ProblemBuilder(NodeReader):
             units=self.units,
             source=self.report.source,
         )
+        if validation.unsampleable(problem):
+            self.error(
+                root.child("initial"),
+                f"no collision-free initial state in {validation.SAMPLE_DRAWS} draws from the "
+                "initial uncertainties (objects overlap each other, an obstacle or a wall in "
+                "every one); expected uncertainties from which particles can be drawn",
+            )
+            return None
+        return problem
+
+    def check_goal_on_table(
+        self, root: Node, table: Table, objects: dict[str, _Object], goal: Goal
+    ) -> None:
+        """An absolute goal whose part cannot be on the table is an error; one whose part
+        sticks out of the table at the target pose a warning."""
+        if goal.is_relative:
+            return
+        poses = root.child("goal").child("poses")
+        nodes = {str(key.value): value for key, value in poses.entries()}
+        units = self.units
+        for name, pose in goal.targets:
+            shape = objects[name].shape
+            if shape is None:
+                continue
+            found = validation.goal_outside(shape, pose, goal.tolerance[:2], table.size)
+            if found is None:
+                continue
+            verdict, (xmin, ymin, xmax, ymax) = found
+            spans = ", ".join(
+                f"{axis} {fmt(units.length_out(lo))}..{fmt(units.length_out(hi))}"
+                for axis, lo, hi in (("x", xmin, xmax), ("y", ymin, ymax))
+            )
+            width, depth = (fmt(units.length_out(v)) for v in table.size)
+            where = f"the table [0, {width}] x [0, {depth}] {units.length}"
+            if verdict == "unreachable":
+                self.error(
+                    nodes[name],
+                    f"the goal of {name} is off the table even within the tolerance (its "
+                    f"centroid must be on {where}); expected a goal pose on the table",
+                )
+            else:
+                self.report.warning(
+                    nodes[name],
+                    None,
+                    f"at its goal pose {name} spans {spans}, beyond {where}: only poses "
+                    "within the tolerance that keep it on the table can meet the goal",
+                )
 
     # -- format, name, description, units -------------------------------------------------------
     def format(self, root: Node) -> None:
@@ -646,7 +696,10 @@ class ProblemBuilder(NodeReader):
         if values is None:
             return None
         dx, dy = self.units.length_in(values[0]), self.units.length_in(values[1])
-        return (dx, dy, self.units.angle_in(values[2]) if len(values) == 3 else None)
+        if len(values) == 2:
+            return (dx, dy, None)
+        dtheta = self.angle(node.items()[2], values[2])
+        return None if dtheta is None else (dx, dy, dtheta)
 
     def reference(self, relative: Node, objects: dict[str, _Object]) -> str | None:
         node = self.required(relative, "reference", "the name of a declared part")
@@ -724,14 +777,24 @@ class ProblemBuilder(NodeReader):
                 values[key] = self.half_widths(node.child(key))
                 ok &= values[key] is not None
         units = self.units
-        for key, convert in (
-            ("friction", float),
-            ("part_density", units.density_in),
-            ("manipulator_density", units.density_in),
+        # densities must be positive: a body of zero mass cannot be simulated
+        for key, convert, positive in (
+            ("friction", float, False),
+            ("part_density", units.density_in, True),
+            ("manipulator_density", units.density_in, True),
         ):
             if node.has(key):
-                values[key] = self.range(node.child(key), convert)
+                values[key] = self.range(node.child(key), convert, positive=positive)
                 ok &= values[key] is not None
+        friction = values.get("friction")
+        if friction is not None and friction[1] > validation.MAX_FRICTION:
+            self.report.warning(
+                node.child("friction"),
+                None,
+                f"friction up to {fmt(friction[1])} is far above real table-top materials "
+                f"(below ~1.5); every push will stick. Expected at most "
+                f"{fmt(validation.MAX_FRICTION)}: check the value",
+            )
         return Uncertainty(**values) if ok else None
 
     # -- planning hints -------------------------------------------------------------------------
@@ -769,10 +832,14 @@ class ProblemBuilder(NodeReader):
                     for o in offsets
                 )
         if node.has("place_angles"):
-            numbers = self.numbers(node.child("place_angles"), "angle", positive=False)
-            ok &= numbers is not None
+            child = node.child("place_angles")
+            numbers = self.numbers(child, "angle", positive=False)
+            angles = None
             if numbers is not None:
-                hints["place_angles"] = tuple(units.angle_in(v) for v in numbers)
+                angles = [self.angle(i, v) for i, v in zip(child.items(), numbers, strict=True)]
+            ok &= angles is not None and None not in angles
+            if ok and angles is not None:
+                hints["place_angles"] = tuple(angles)
         if node.has("push_distances"):
             numbers = self.numbers(node.child("push_distances"), "distance", positive=True)
             ok &= numbers is not None

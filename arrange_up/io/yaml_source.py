@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
+import sys
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +26,7 @@ from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
 from ruamel.yaml.reader import ReaderError
 from ruamel.yaml.scalarbool import ScalarBoolean
 
+from arrange_up.io.validation import angle_problem
 from arrange_up.model.errors import Diagnostic
 from arrange_up.model.problem import Pose
 from arrange_up.model.units import Units
@@ -38,6 +41,7 @@ __all__ = [
     "fmt",
     "is_number",
     "join",
+    "long_number",
     "parse",
     "read_text",
     "root_node",
@@ -102,14 +106,32 @@ def parse(text: str, report: Report) -> Any:
         report.error(
             (line, column),
             "",
-            f"not valid YAML: character {_char(error.character)} is not allowed in a YAML file",
+            f"not valid YAML: character {_char(error.character)} is not allowed in a YAML file; "
+            "expected printable text",
         )
         return None
     except YAMLError as error:
         report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
         return None
     except RecursionError:
-        report.error(None, "", "not a problem file: the YAML is nested too deeply")
+        report.error(
+            None,
+            "",
+            "not a problem file: the YAML is nested too deeply; expected a mapping of the "
+            "format's sections (name, table, objects, goal, ...)",
+        )
+        return None
+    except ValueError as error:  # an integer of more digits than Python converts
+        line, column, digits = long_number(text)
+        if digits:
+            report.error(
+                (line, column),
+                "",
+                f"a number of {digits} digits; expected a finite number (a double, at most "
+                "about 1e308)",
+            )
+        else:
+            report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
         return None
 
     if node is None or data is None:
@@ -132,10 +154,22 @@ def parse(text: str, report: Report) -> Any:
         report.error(
             (line, column),
             path,
-            f"duplicate key {key!r} (first given at line {first[0]}, column {first[1]}); each "
-            "key may appear only once in a mapping",
+            f"duplicate key {key!r} (first given at line {first[0]}, column {first[1]}); "
+            "expected each key at most once in a mapping",
         )
     return data
+
+
+def long_number(text: str) -> tuple[int | None, int | None, int]:
+    """``(line, column, digits)`` of the first run of more digits than Python converts to an
+    integer (``sys.get_int_max_str_digits()``), or ``(None, None, 0)``."""
+    limit = sys.get_int_max_str_digits() if hasattr(sys, "get_int_max_str_digits") else 4300
+    match = re.search(rf"\d{{{limit + 1},}}", text) if limit else None
+    if match is None:
+        return None, None, 0
+    before = text[: match.start()]
+    line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+    return line, column, len(match.group(0))
 
 
 def _find_duplicates(root: Any) -> Iterator[tuple[int, int, str, str, tuple[int, int]]]:
@@ -420,14 +454,28 @@ class NodeReader:
                 ok = False
         return values if ok else None
 
+    def angle(self, node: Node, value: float) -> float | None:
+        """``value`` (the file's angle unit, read from ``node``) in radians, or None after
+        reporting an angle too large to mean an orientation (:data:`validation.MAX_ANGLE`)."""
+        radians = self.units.angle_in(value)
+        reason = angle_problem(radians)
+        if reason is not None:
+            self.error(node, f"angle {fmt(value)} {self.units.angle}: {reason}")
+            return None
+        return radians
+
     def pose(self, node: Node) -> Pose | None:
         values = self.vector(node, ("x", "y", "theta"))
-        return None if values is None else self.units.pose_in(values)  # type: ignore[arg-type]
+        if values is None or self.angle(node.items()[2], values[2]) is None:
+            return None
+        return self.units.pose_in(values)  # type: ignore[arg-type]
 
     def half_widths(self, node: Node) -> tuple[float, float, float] | None:
         values = self.vector(node, ("dx", "dy", "dtheta"))
         values = self.non_negative(node, values, "half-width")
-        return None if values is None else self.units.pose_in(values)  # type: ignore[arg-type]
+        if values is None or self.angle(node.items()[2], values[2]) is None:
+            return None
+        return self.units.pose_in(values)  # type: ignore[arg-type]
 
     def list_of(self, node: Node, expected: str) -> list[Node] | None:
         if not node.is_seq or not node.value:
@@ -436,8 +484,13 @@ class NodeReader:
             return None
         return node.items()
 
-    def range(self, node: Node, convert: Callable[[float], float]) -> tuple[float, float] | None:
-        values = self.non_negative(node, self.vector(node, ("low", "high")), "value")
+    def range(
+        self, node: Node, convert: Callable[[float], float], *, positive: bool = False
+    ) -> tuple[float, float] | None:
+        """A uniform range ``[low, high]`` with ``0 <= low <= high`` (``0 < low`` when
+        ``positive``), converted by ``convert``."""
+        values = self.vector(node, ("low", "high"))
+        values = (self.positive if positive else self.non_negative)(node, values, "value")
         if values is None:
             return None
         low, high = values
@@ -445,7 +498,7 @@ class NodeReader:
             self.error(
                 node,
                 f"low {fmt(low)} is above high {fmt(high)}; expected [low, high] "
-                "with 0 <= low <= high",
+                f"with 0 {'<' if positive else '<='} low <= high",
             )
             return None
         return (convert(low), convert(high))

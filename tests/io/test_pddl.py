@@ -218,3 +218,21 @@ def test_a_malformed_catalogue_is_refused(tmp_path: Path):
     bad.write_text("format: arrange-up-shapes/1\ntypes:\n  blob: {kind: part, box: [1, -1]}\n")
     with pytest.raises(CatalogueError, match=r"types\.blob\.box: box size must be positive"):
         load_catalogue(bad)
+
+
+def test_the_pddl_reader_warns_as_the_yaml_reader_does():
+    # warnings do not refuse a file; a command that loads it prints them (check_pddl_problem)
+    from arrange_up.io.pddl_reader import check_pddl_problem_text
+
+    text = (
+        (domains_dir() / "blocks-1.pddl")
+        .read_text()
+        .replace("(= (friction-max) 0.55)", "(= (friction-max) 1000000)")
+        .replace("(>= (x A) 9.3) (<= (x A) 9.7)", "(>= (x A) 9.5) (<= (x A) 9.9)")
+    )
+    problem, diagnostics = check_pddl_problem_text(text, "b1.pddl")
+    assert problem is not None
+    warnings = [str(d) for d in diagnostics]
+    assert len(warnings) == 2 and all(": warning: " in w for w in warnings)
+    assert "b1.pddl:27:32:" in warnings[0] and "(friction-max) is 1000000" in warnings[0]
+    assert "b1.pddl:31:" in warnings[1] and "at its goal pose A spans x 9.2..10.2" in warnings[1]

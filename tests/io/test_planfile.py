@@ -7,6 +7,7 @@ import json
 import math
 import os
 import re
+import stat
 from pathlib import Path
 
 import pytest
@@ -255,3 +256,14 @@ def test_plan_problem_mismatch_warns_only_for_other_content():
     # Nothing recorded: nothing to compare.
     assert plan_problem_mismatch({"format": PLAN_FORMAT}, mm) is None
     assert plan_problem_mismatch([], mm) is None  # type: ignore[arg-type]
+
+
+def test_an_atomic_write_gives_the_file_the_umask_permissions(tmp_path):
+    # the temporary file is private (0o600); the file written must not stay so
+    previous = os.umask(0o022)
+    try:
+        written = write_text_atomic(tmp_path / "plan.json", "{}\n")
+    finally:
+        os.umask(previous)
+    assert stat.S_IMODE(written.stat().st_mode) == 0o644
+    assert [p.name for p in tmp_path.iterdir()] == ["plan.json"]  # no temporary file left

@@ -2,11 +2,23 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from arrange_up.geometry import shapes as geometry
 from arrange_up.io.pddl import load_pddl_problem_text, write_pddl_problem
-from arrange_up.io.validation import AREA_TOLERANCE, Placed, check_placement, part_overlaps
+from arrange_up.io.validation import (
+    AREA_TOLERANCE,
+    MAX_ANGLE,
+    SAMPLE_DRAWS,
+    Placed,
+    angle_problem,
+    check_placement,
+    goal_outside,
+    part_overlaps,
+    unsampleable,
+)
 from arrange_up.io.yaml_problem import check_problem_text, load_problem_text
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import Shape
@@ -92,3 +104,64 @@ def test_part_overlaps_reports_each_overlapping_pair_once() -> None:
     assert (i, j, i2, j2) == (0, 2, 1, 2)
     assert area == pytest.approx(0.25) and area2 == pytest.approx(0.25)
     assert part_overlaps([left, touching]) == []
+
+
+def test_angles_beyond_the_resolution_of_a_double_are_refused() -> None:
+    assert angle_problem(0.0) is None and angle_problem(-MAX_ANGLE) is None
+    for bad in (MAX_ANGLE * 2, 1e300, float("nan"), float("inf")):
+        assert "expected an angle" in (angle_problem(bad) or "")
+
+
+def test_a_goal_off_the_table_is_unreachable_one_at_its_edge_sticks_out() -> None:
+    table, tolerance = (10.0, 5.0), (0.2, 0.2)
+    assert goal_outside(BLOCK, (5.0, 2.0, 0.0), tolerance, table) is None
+    assert goal_outside(BLOCK, (9.7, 2.0, 0.0), tolerance, table)[0] == "sticks out"
+    # the centroid 0.1 in beyond the edge, within the tolerance: still reachable in principle
+    assert goal_outside(BLOCK, (10.1, 2.0, 0.0), tolerance, table)[0] == "sticks out"
+    verdict, bounds = goal_outside(BLOCK, (10.3, 2.0, 0.0), tolerance, table)
+    assert verdict == "unreachable" and bounds == pytest.approx((9.8, 1.5, 10.8, 2.5))
+
+
+ROW = """\
+name: row
+table: {size: [10, 5], walls: [left]}
+objects:
+  A: {kind: part, shape: {box: [1, 1]}}
+  B: {kind: part, shape: {box: [1, 1]}}
+initial:
+  A: {pose: [0.5, 2, 0], uncertainty: [0, 0, 0]}
+  B: {pose: [1.5, 2, 0]}
+goal:
+  tolerance: [0.2, 0.2]
+  poses: {A: [5, 2, 0]}
+"""
+
+
+def test_a_belief_is_unsampleable_only_when_no_draw_is_free() -> None:
+    problem = load_problem_text(ROW)
+    assert not unsampleable(problem)  # nothing uncertain: nothing to draw
+
+    def moving(half: float):
+        a, b = problem.initial
+        return dataclasses.replace(
+            problem, initial=(dataclasses.replace(a, uncertainty=(half, 0.0, 0.0)), b)
+        )
+
+    # A pressed between the wall and B: every draw that moves it overlaps one of them
+    assert unsampleable(moving(0.3))
+    # B away from A: every draw that moves A to the right is free
+    moved = moving(0.3)
+    b = moved.initial[1]
+    spaced = dataclasses.replace(
+        moved, initial=(moved.initial[0], dataclasses.replace(b, pose=(3.0, 2.0, 0.0)))
+    )
+    assert not unsampleable(spaced)
+
+
+def test_the_readers_refuse_an_unsampleable_belief_where_it_is_written() -> None:
+    text = ROW.replace("uncertainty: [0, 0, 0]", "uncertainty: [0.3, 0, 0]")
+    problem, diagnostics = check_problem_text(text, "row.yaml")
+    assert problem is None
+    (error,) = diagnostics
+    assert str(error).startswith("row.yaml:7:3: error: initial: no collision-free initial state")
+    assert f"in {SAMPLE_DRAWS} draws" in error.message

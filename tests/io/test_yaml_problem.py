@@ -732,8 +732,14 @@ def test_refuses_a_negative_goal_tolerance(tmp_path: Path) -> None:
 
 
 def test_refuses_a_negative_range(tmp_path: Path) -> None:
-    path = write(tmp_path, MINIMAL + "    uncertainty:\n      part_density: [-0.1, 0.1]\n")
-    refused_with(path, where(path, "-0.1"), "uncertainty.part_density[0]", "expected a value >= 0")
+    path = write(tmp_path, MINIMAL + "    uncertainty:\n      friction: [-0.1, 0.1]\n")
+    refused_with(path, where(path, "-0.1"), "uncertainty.friction[0]", "expected a value >= 0")
+
+
+def test_refuses_a_density_of_zero(tmp_path: Path) -> None:
+    # a body of zero mass cannot be simulated: the physics refused it in the middle of a search
+    path = write(tmp_path, MINIMAL + "    uncertainty:\n      part_density: [0, 0.1]\n")
+    refused_with(path, where(path, "0, 0.1"), "uncertainty.part_density[0]", "expected a value > 0")
 
 
 def test_refuses_a_range_whose_low_is_above_its_high(tmp_path: Path) -> None:
