@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import click
 
-from arrange_up.cli.shared import SEED, comma_integers, comma_separated, library_default
+from arrange_up.cli.shared import (
+    comma_integers,
+    comma_separated,
+    library_default,
+    seed_option,
+)
 from arrange_up.physics.bench import bench_physics
 
 
@@ -28,7 +33,7 @@ def bench() -> None:
     show_default=True,
     help="Comma-separated process counts to measure.",
 )
-@click.option("--seed", type=SEED, default=0, show_default=True)
+@seed_option("Seeds the noise of the pushes.")
 def bench_physics_command(pushes: int, workers: str, seed: int) -> None:
     """Push rollouts per second: 1 block, a 3-block and a 7-block chain against a wall.
 

@@ -15,15 +15,16 @@ from rich.progress import (
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
-    SEED,
     OutputFile,
     backend_choice,
     echo_json,
     fail,
+    json_option,
     library_default,
     load_problem,
     parallel_options,
     read_plan_file,
+    seed_option,
     terminal_progress,
 )
 from arrange_up.evaluation.evaluate import (
@@ -99,13 +100,7 @@ def _failure_lines(
     show_default=True,
     help="Noisy executions of the plan.",
 )
-@click.option(
-    "--seed",
-    type=SEED,
-    default=0,
-    show_default=True,
-    help="Rollout i draws its noise from (seed, i): equal seeds give equal results.",
-)
+@seed_option("Rollout i draws its noise from (seed, i): equal seeds give equal results.")
 @parallel_options("rollouts")
 @click.option(
     "--record",
@@ -114,12 +109,7 @@ def _failure_lines(
     help="Append every rollout to this .jsonl file as it finishes; re-running with the same "
     "file resumes the evaluation.",
 )
-@click.option(
-    "--json",
-    "as_json",
-    is_flag=True,
-    help="Print a machine-readable summary (JSON) on stdout.",
-)
+@json_option("Print a machine-readable summary (JSON) on stdout.")
 def evaluate(
     problem: str,
     plan_file: str,

@@ -29,7 +29,9 @@ from arrange_up.cli.shared import (
     library_default,
     load_problem,
     parallel_options,
+    seed_option,
     terminal_progress,
+    timeout_option,
 )
 from arrange_up.experiments import costs
 from arrange_up.experiments.csv_records import read_csv
@@ -204,12 +206,7 @@ def _refuse_bad_problems(names: list[str]) -> None:
     default=library_default(transition_comparison, "max_nodes"),
     show_default=True,
 )
-@click.option(
-    "--timeout",
-    type=FiniteFloat(0, None, min_open=True),
-    default=None,
-    help="Planning time limit per run, seconds.",
-)
+@timeout_option("Planning time limit per run, seconds.")
 @click.option(
     "--workers",
     type=click.IntRange(1, 256),
@@ -295,12 +292,7 @@ def experiment_transition_comparison(
     show_default=True,
     help="1 = A*, as in the thesis's table.",
 )
-@click.option(
-    "--timeout",
-    type=FiniteFloat(0, None, min_open=True),
-    default=None,
-    help="Time limit per search, seconds.",
-)
+@timeout_option("Time limit per search, seconds.")
 @click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
 def experiment_search_table(
     problems: str,
@@ -371,13 +363,7 @@ def experiment_search_table(
     show_default=True,
     help="Noisy rollouts per nominal and per repaired plan (0: no evaluation).",
 )
-@click.option(
-    "--seed",
-    type=click.IntRange(0, None),
-    default=0,
-    show_default=True,
-    help="Seeds the nominal plans, the repairs' particles and noise, and the rollouts.",
-)
+@seed_option("Seeds the nominal plans, the repairs' particles and noise, and the rollouts.")
 @click.option(
     "--method",
     type=click.Choice(METHODS),
@@ -385,12 +371,9 @@ def experiment_search_table(
     show_default=True,
     help="Candidate placements of the repair (see 'arrange-up repair --help').",
 )
-@click.option(
-    "--timeout",
-    type=FiniteFloat(0, None, min_open=True),
-    default=None,
-    help="Time limit per repair, seconds (the thesis allowed 24 hours); a repair that reaches "
-    "it is recorded with status 'timeout'.",
+@timeout_option(
+    "Time limit per repair, seconds (the thesis allowed 24 hours); a repair that reaches "
+    "it is recorded with status 'timeout'."
 )
 @parallel_options("rollouts")
 @click.option(

@@ -11,7 +11,6 @@ from rich.progress import TextColumn
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
-    SEED,
     FiniteFloat,
     OutputFile,
     actions_table,
@@ -19,9 +18,12 @@ from arrange_up.cli.shared import (
     document_summary,
     echo_json,
     fail,
+    json_option,
     library_default,
     load_problem,
+    seed_option,
     terminal_progress,
+    timeout_option,
 )
 from arrange_up.io.planfile import plan_document, write_json_atomic
 from arrange_up.parallel import available_cores
@@ -57,25 +59,14 @@ def _status_line(stats: dict[str, Any]) -> str:
     show_default=True,
     help="Particles per belief (particle semantics).",
 )
-@click.option(
-    "--seed",
-    type=SEED,
-    default=0,
-    show_default=True,
-    help="Seed for initial particles and noise: equal seeds give equal plans.",
-)
+@seed_option("Seed for initial particles and noise: equal seeds give equal plans.")
 @click.option(
     "--max-nodes",
     type=click.IntRange(1, None),
     default=None,
     help=f"Node limit (default: the problem's planning.max_nodes, else {DEFAULT_MAX_NODES}).",
 )
-@click.option(
-    "--timeout",
-    type=FiniteFloat(0, None, min_open=True),
-    default=None,
-    help="Give up after this many seconds.",
-)
+@timeout_option("Give up after this many seconds.")
 @click.option(
     "--heuristic",
     default=library_default(run_plan, "heuristic"),
@@ -104,12 +95,7 @@ def _status_line(stats: dict[str, Any]) -> str:
     default=None,
     help="Write the plan file (JSON, documented in docs/plan-format.md).",
 )
-@click.option(
-    "--json",
-    "as_json",
-    is_flag=True,
-    help="Print a machine-readable summary (JSON) on stdout instead of the table.",
-)
+@json_option("Print a machine-readable summary (JSON) on stdout instead of the table.")
 def plan(
     problem: str,
     semantics: str,

@@ -10,15 +10,16 @@ import click
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
-    SEED,
     OutputFile,
     actions_table,
     document_summary,
     echo_json,
     fail,
+    json_option,
     library_default,
     load_problem,
     read_plan_file,
+    seed_option,
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
@@ -87,13 +88,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     show_default=True,
     help="Particles of the belief the candidates are scored on.",
 )
-@click.option(
-    "--seed",
-    type=SEED,
-    default=0,
-    show_default=True,
-    help="Seed for the particles, the noise and the nominal plan: equal seeds, equal plans.",
-)
+@seed_option("Seed for the particles, the noise and the nominal plan: equal seeds, equal plans.")
 @click.option(
     "--method",
     type=click.Choice(METHODS),
@@ -116,12 +111,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     help="Write the repaired plan file (JSON; semantics 'fixtures', per-step choices under "
     "'repair').",
 )
-@click.option(
-    "--json",
-    "as_json",
-    is_flag=True,
-    help="Print a machine-readable summary (JSON) on stdout instead of the table.",
-)
+@json_option("Print a machine-readable summary (JSON) on stdout instead of the table.")
 def repair(
     problem: str,
     plan_file: str | None,

@@ -123,6 +123,23 @@ def unwritable(path: Path) -> str | None:
     return None
 
 
+def seed_option(help: str) -> Callable[[Any], Any]:
+    """``--seed``: a non-negative integer, default 0; ``help`` says what it seeds."""
+    return click.option("--seed", type=SEED, default=0, show_default=True, help=help)
+
+
+def timeout_option(help: str) -> Callable[[Any], Any]:
+    """``--timeout``: positive finite seconds, default none; ``help`` says what it limits."""
+    return click.option(
+        "--timeout", type=FiniteFloat(0, None, min_open=True), default=None, help=help
+    )
+
+
+def json_option(help: str) -> Callable[[Any], Any]:
+    """``--json`` (the ``as_json`` flag): print a machine-readable summary on stdout."""
+    return click.option("--json", "as_json", is_flag=True, help=help)
+
+
 def library_default(function: Callable[..., Any], parameter: str) -> Any:
     """The default of ``function``'s ``parameter``: an option whose default is the library's
     shows and uses that one, so the two cannot drift apart."""

@@ -12,12 +12,12 @@ import click
 from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
 from arrange_up.cli.shared import (
-    SEED,
     OutputFile,
     fail,
     library_default,
     load_problem,
     read_plan_file,
+    seed_option,
     terminal_progress,
 )
 from arrange_up.figures.animation import WriterUnavailableError, animate_plan, check_writer
@@ -81,13 +81,7 @@ from arrange_up.transitions import available
     show_default=True,
     help="Animation frames per action (interpolated between the states before and after it).",
 )
-@click.option(
-    "--seed",
-    type=SEED,
-    default=0,
-    show_default=True,
-    help="Seed of the storyboard's rollouts (as in `evaluate`).",
-)
+@seed_option("Seed of the storyboard's rollouts (as in `evaluate`).")
 @click.option(
     "--heatmap",
     "heatmap_step",

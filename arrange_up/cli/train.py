@@ -16,14 +16,15 @@ from arrange_up.cbst.features import TARGET_NAMES, TARGET_UNITS
 from arrange_up.cbst.model import train_cbst as run_training
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
-    SEED,
     OutputDir,
     OutputFile,
     backend_choice,
     echo_json,
     fail,
+    json_option,
     library_default,
     parallel_options,
+    seed_option,
     terminal_progress,
 )
 from arrange_up.parallel import BackendUnavailableError
@@ -48,13 +49,7 @@ _STAGE_LABELS = {"data": "examples", "fit": "grid search"}
     help="Simulated pushes per example (thesis: 1000, ~45 min on 2 cores here; the "
     "shipped model used 100, ~6 min).",
 )
-@click.option(
-    "--seed",
-    type=SEED,
-    default=0,
-    show_default=True,
-    help="Example i depends only on (seed, i); also seeds the split and the forest.",
-)
+@seed_option("Example i depends only on (seed, i); also seeds the split and the forest.")
 @parallel_options("examples")
 @click.option(
     "--output-dir",
@@ -76,7 +71,7 @@ _STAGE_LABELS = {"data": "examples", "fit": "grid search"}
     default=None,
     help="Resumable .jsonl data file (default OUTPUT_DIR/NAME.data.jsonl).",
 )
-@click.option("--json", "as_json", is_flag=True, help="Print the model card (JSON) on stdout.")
+@json_option("Print the model card (JSON) on stdout.")
 def train_cbst(
     examples: int,
     rollouts_per_example: int,
