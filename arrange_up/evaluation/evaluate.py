@@ -159,9 +159,14 @@ def evaluate_plan(
     keep_records
         Keep every rollout's record in :attr:`Reliability.records`.
 
-    Raises ``ValueError`` for bad arguments or a problem whose initial belief cannot be
-    sampled, :class:`RecordFileError` for a record file of another evaluation, and
-    :class:`arrange_up.parallel.BackendUnavailableError` when the backend is missing.
+    Raises
+    ------
+    ValueError
+        For bad arguments, or a problem whose initial belief cannot be sampled.
+    RecordFileError
+        For a record file of another evaluation.
+    arrange_up.parallel.BackendUnavailableError
+        When the backend is missing.
     """
     started = time.perf_counter()
     if not isinstance(rollouts, int) or isinstance(rollouts, bool) or rollouts < 1:

@@ -2,12 +2,11 @@
 
 :func:`fixture_experiment` measures, for each rearrangement problem, how much
 :func:`arrange_up.repair.fixture_repair.repair_plan` improves the reliability of nominal
-(deterministic) plans
-and what it costs, as a function of the particles of the belief it scores candidates on:
+(deterministic) plans and what it costs, as a function of the particles of the belief it scores
+candidates on:
 
-1. ``K`` distinct nominal plans from :func:`arrange_up.repair.fixture_repair.nominal_plans` (seed
-``seed``;
-   the thesis used 20 per problem);
+1. ``K`` distinct nominal plans from :func:`arrange_up.repair.fixture_repair.nominal_plans`
+   (seed ``seed``; the thesis used 20 per problem);
 2. each nominal plan is evaluated by :func:`arrange_up.evaluation.evaluate.evaluate_plan` over
    ``rollouts`` noisy rollouts (one CSV row, stage ``nominal``);
 3. each nominal plan is repaired once per particle count (repair seed ``seed``) and the repaired

@@ -103,8 +103,10 @@ class PlanStatistics(SearchSnapshot):
 class PlanResult:
     """The outcome of :func:`plan`.
 
-    ``actions`` (internal units) and ``beliefs`` (the predicted belief before the first action
-    and after each action, for storyboards) are set iff ``status == "solved"``.
+    ``actions`` (internal units: poses and distances in inches, angles in **radians**, whatever
+    the problem file's units; plan files and the command line show the file's units, degrees by
+    default) and ``beliefs`` (the predicted belief before the first action and after each
+    action, for storyboards) are set iff ``status == "solved"``.
     ``statistics`` holds the search statistics; :attr:`stats` is their JSON form.
     """
 
