@@ -145,6 +145,11 @@ def angle_problem(value: float) -> str | None:
     )
 
 
+#: The share of a goal's x or y tolerance a part may overhang the table at its target pose before
+#: :func:`goal_outside` says it sticks out.
+OVERHANG_SHARE = 0.1
+
+
 def goal_outside(
     shape: Shape, pose: Pose, tolerance: tuple[float, float], table_size: tuple[float, float]
 ) -> tuple[str, Bounds] | None:
@@ -152,9 +157,10 @@ def goal_outside(
 
     ``("unreachable", bounds)`` when the centroid cannot be on the table within the x/y
     ``tolerance`` (a part on the table has its centroid in the convex hull of its footprint,
-    hence on the table); ``("sticks out", bounds)`` when the footprint at the target pose is not
-    within the table (the goal may still be met by a pose within the tolerance); ``None`` when
-    the footprint at the target pose lies on the table. ``bounds`` is the footprint's
+    hence on the table); ``("sticks out", bounds)`` when the footprint at the target pose
+    reaches beyond the table by more than :data:`OVERHANG_SHARE` of the tolerance (the goal may
+    still be met by a pose within the tolerance); ``None`` otherwise. ``bounds`` is the
+    footprint's
     ``(xmin, ymin, xmax, ymax)`` at the target pose.
     """
     width, depth = table_size
@@ -164,8 +170,10 @@ def goal_outside(
     if x + dx < 0 or y + dy < 0 or x - dx > width or y - dy > depth:
         return "unreachable", footprint
     xmin, ymin, xmax, ymax = footprint
-    tol = BOUNDS_TOLERANCE
-    if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
+    # An overhang smaller than a tenth of the tolerance is the rounding of a decimal pose
+    # against a wall (a centroid at 5/6 written 0.83), not a goal off the table.
+    tx, ty = (max(BOUNDS_TOLERANCE, OVERHANG_SHARE * d) for d in (dx, dy))
+    if xmin < -tx or ymin < -ty or xmax > width + tx or ymax > depth + ty:
         return "sticks out", footprint
     return None
 

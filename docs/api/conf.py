@@ -20,7 +20,9 @@ extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon", "sphinx.ext.viewcode"
 # description, where a long signature stays readable.
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
-autodoc_default_options = {"members": True, "show-inheritance": True}
+# A module documents what it defines: the re-exports that keep former import paths working
+# (``__all__`` lists that name another module's objects) would document an object twice.
+autodoc_default_options = {"members": True, "show-inheritance": True, "ignore-module-all": True}
 # Docstrings name code with ``double backticks`` and cross-reference with :func:, :class: and
 # :mod:; single backticks are an inline literal too (a few docstrings use Markdown's).
 default_role = "code"
