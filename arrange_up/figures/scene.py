@@ -33,7 +33,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from arrange_up.figures import render
-from arrange_up.geometry.se2 import compose
+from arrange_up.geometry.se2 import compose, rotate
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
 
@@ -261,9 +261,8 @@ def draw_action(ax: Axes, problem: ArrangementProblem, action: Action, t: float 
         )
     elif isinstance(action, Push):
         spec = problem.object(action.manipulator)
-        px, py = spec.push_direction
-        c, s = math.cos(action.pose[2]), math.sin(action.pose[2])
-        dx, dy = (c * px - s * py) * action.distance, (s * px + c * py) * action.distance
+        ux, uy = rotate(spec.push_direction, action.pose[2])
+        dx, dy = ux * action.distance, uy * action.distance
         x, y, theta = action.pose
         render.draw_object(ax, spec, (x + t * dx, y + t * dy, theta), color="0.15", zorder=5)
         ax.annotate(
