@@ -20,7 +20,11 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
 * ``SOLVED_SATISFICING``: a ``SequentialPlan`` of ``place``/``push``/``pick`` instances with
   exact ``Fraction`` real parameters (inches, degrees). For a problem read from PDDL, whose
   actions cannot carry real parameters, the instances belong to ``to_up`` of the same problem
-  (a log message says so).
+  (a log message says so), with the names as ``PDDLReader`` read them (lowercase). The
+  validator and the repairer read a plan's object names case-insensitively where the problem
+  has no object of the exact name (PDDL names are case-insensitive), so such a plan is judged
+  against ``to_up(load_pddl_problem(file))`` too; ``plan_from_up(plan, problem)`` names its
+  actions' objects as ``problem`` does, for any other use.
 * ``UNSOLVABLE_INCOMPLETELY``: the node limit was reached, or the search space was exhausted
   under pruning (the search is incomplete, so nothing is proven).
 * ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
@@ -549,7 +553,7 @@ def _read_problem_and_plan(
     if isinstance(arrangement, _Refusal):
         return arrangement
     try:
-        actions = plan_from_up(plan)
+        actions = plan_from_up(plan, arrangement)
     except ValueError as error:
         return _Refusal(f"not a sequential plan of place/push/pick actions: {error}")
     except Exception as error:  # plan_from_up refuses foreign plans with ValueError
