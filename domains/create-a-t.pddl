@@ -38,8 +38,8 @@
   (:goal (and
     (on-table top)
     (on-table stem)
-    (>= (rel-x stem top) -0.25) (<= (rel-x stem top) 0.25)
-    (>= (rel-y stem top) -2.25) (<= (rel-y stem top) -1.75)
-    (>= (rel-theta stem top) -10) (<= (rel-theta stem top) 10)
+    (>= (rel-x stem top) (- 0.25)) (<= (rel-x stem top) 0.25)
+    (>= (rel-y stem top) (- 2.25)) (<= (rel-y stem top) (- 1.75))
+    (>= (rel-theta stem top) (- 10)) (<= (rel-theta stem top) 10)
   ))
 )

@@ -38,6 +38,6 @@
     (on-table block)
     (>= (x block) 4.75) (<= (x block) 7.25)
     (>= (y block) 2.5) (<= (y block) 3.5)
-    (>= (theta block) -15) (<= (theta block) 15)
+    (>= (theta block) (- 15)) (<= (theta block) 15)
   ))
 )

@@ -41,7 +41,7 @@
     (on-table T1)
     (on-table T2)
     (>= (rel-x T2 T1) 0.8) (<= (rel-x T2 T1) 1.2)
-    (>= (rel-y T2 T1) -2) (<= (rel-y T2 T1) -1.6)
+    (>= (rel-y T2 T1) (- 2)) (<= (rel-y T2 T1) (- 1.6))
     (>= (rel-theta T2 T1) 170) (<= (rel-theta T2 T1) 190)
   ))
 )

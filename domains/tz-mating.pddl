@@ -43,7 +43,7 @@
     (on-table T)
     (on-table Z)
     (>= (rel-x Z T) 1.3) (<= (rel-x Z T) 1.7)
-    (>= (rel-y Z T) -0.6) (<= (rel-y Z T) -0.2)
+    (>= (rel-y Z T) (- 0.6)) (<= (rel-y Z T) (- 0.2))
     (>= (rel-theta Z T) 80) (<= (rel-theta Z T) 100)
   ))
 )

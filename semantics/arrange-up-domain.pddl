@@ -25,14 +25,14 @@
   )
 
   (:predicates
-    (on-table ?o - object)   ; in :init, the object starts on the table
+    (on-table ?o)   ; in :init, the object starts on the table
     (wall-left) (wall-right) (wall-bottom) (wall-top)   ; rigid walls along the table's edges
   )
 
   (:functions
     ; nominal pose (x, y in inches; theta in degrees) of an object on the table at the start,
     ; or of an obstacle; the pose refers to the shape's area centroid
-    (x ?o - object) (y ?o - object) (theta ?o - object)
+    (x ?o) (y ?o) (theta ?o)
     ; half-widths of the initial uncertainty: the pose lies in x +- dx, y +- dy, theta +- dtheta
     (dx ?o - movable) (dy ?o - movable) (dtheta ?o - movable)
     ; pose of part ?p in the frame of part ?r (relative goals)

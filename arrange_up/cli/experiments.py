@@ -34,7 +34,7 @@ from arrange_up.cli.shared import (
     timeout_option,
 )
 from arrange_up.experiments import costs
-from arrange_up.experiments.csv_records import read_csv
+from arrange_up.experiments.csv_records import CsvRecordsError, read_csv
 from arrange_up.experiments.fixtures import (
     CSV_NAME,
     DEFAULT_PARTICLES,
@@ -243,19 +243,22 @@ def experiment_transition_comparison(
         evaluation = costs.rollout_cost(name, rollouts)
         total = None if planning is None or evaluation is None else planning + evaluation
         estimate.add(total, f"{name} {label}")
-    with _measurements(estimate, len(pending)) as report:
-        path = transition_comparison(
-            Path(output_dir),
-            problems=names,
-            planners=planners,
-            runs=runs,
-            rollouts=rollouts,
-            max_nodes=max_nodes,
-            timeout=timeout,
-            workers=workers,
-            progress=report.say,
-            measured=lambda row: report.done(_transition_line(row)),
-        )
+    try:
+        with _measurements(estimate, len(pending)) as report:
+            path = transition_comparison(
+                Path(output_dir),
+                problems=names,
+                planners=planners,
+                runs=runs,
+                rollouts=rollouts,
+                max_nodes=max_nodes,
+                timeout=timeout,
+                workers=workers,
+                progress=report.say,
+                measured=lambda row: report.done(_transition_line(row)),
+            )
+    except CsvRecordsError as error:
+        fail(str(error))
     rows = select_transition_rows(read_csv(path), names, [p.label for p in planners], runs)
     click.echo(transition_markdown(rows))
     click.echo(f"wrote {path} and {path.with_suffix('.png')}")
@@ -319,18 +322,21 @@ def experiment_search_table(
         if particles != library_default(search_table, "particles") or weight != 1.0:
             cost = None  # measured with one particle and A* only
         estimate.add(cost, f"{SEARCH_TYPES[k][0]} {name}")
-    with _measurements(estimate, len(pending)) as report:
-        path = search_table(
-            Path(output_dir),
-            problems=names,
-            semantics=semantics,
-            particles=particles,
-            max_nodes=max_nodes,
-            weight=weight,
-            timeout=timeout,
-            progress=report.say,
-            measured=lambda row: report.done(_search_line(row)),
-        )
+    try:
+        with _measurements(estimate, len(pending)) as report:
+            path = search_table(
+                Path(output_dir),
+                problems=names,
+                semantics=semantics,
+                particles=particles,
+                max_nodes=max_nodes,
+                weight=weight,
+                timeout=timeout,
+                progress=report.say,
+                measured=lambda row: report.done(_search_line(row)),
+            )
+    except CsvRecordsError as error:
+        fail(str(error))
     click.echo(search_markdown(select_search_rows(read_csv(path), names, semantics)))
     click.echo(f"wrote {path} and {path.parent / f'search-table-{semantics}.png'}")
 

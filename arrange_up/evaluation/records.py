@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import IO, Any
 
-from arrange_up.evaluation.outcomes import RolloutRecord
+from arrange_up.evaluation.outcomes import FAILURE_KINDS, GOAL_MISSED, RolloutRecord
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Pick, Place, Push
 
@@ -85,6 +86,72 @@ def _dig(data: Any, path: tuple[str, ...]) -> Any:
     for key in path:
         data = data.get(key) if isinstance(data, dict) else None
     return data
+
+
+_DIMENSIONS = frozenset(("x", "y", "theta", "off table"))
+
+
+def _record_problem(data: Any, actions: Any) -> str | None:
+    """What is wrong with the JSON ``data`` of one rollout line of a plan of ``actions``
+    actions, or ``None``. ``RolloutRecord.from_json`` checks the rollout index, the success
+    flag and the failure kind; this checks the rest against the plan, so that a resumed
+    evaluation never counts a line no rollout of this plan could have written."""
+    if not isinstance(data, dict):
+        return f"expected a JSON object, got {type(data).__name__}"
+    for key in ("rollout", "success"):
+        if key not in data:
+            return f"no {key!r}"
+    failure = data.get("failure")
+    if failure is None:
+        return None
+    if not isinstance(failure, dict):
+        return f"failure: expected a JSON object, got {failure!r}"
+    if failure.get("kind") not in FAILURE_KINDS:
+        return (
+            f"failure.kind: unknown failure kind {failure.get('kind')!r}; expected one of "
+            f"{', '.join(FAILURE_KINDS)}"
+        )
+    action = failure.get("action")
+    if failure["kind"] == GOAL_MISSED:
+        if action is not None:
+            return f"failure.action: a missed goal names no action, got {action!r}"
+    elif not _is_int(action) or not 0 <= action < (actions if _is_int(actions) else 0):
+        return (
+            f"failure.action: expected the 0-based index of an action of the plan's {actions}, "
+            f"got {action!r}"
+        )
+    for key in ("reason", "detail"):
+        if failure.get(key) is not None and not isinstance(failure[key], str):
+            return f"failure.{key}: expected text, got {failure[key]!r}"
+    objects = failure.get("objects", [])
+    if not isinstance(objects, list) or not all(isinstance(o, str) for o in objects):
+        return f"failure.objects: expected a list of object names, got {objects!r}"
+    misses = failure.get("misses", [])
+    if not isinstance(misses, list):
+        return f"failure.misses: expected a list, got {misses!r}"
+    for k, miss in enumerate(misses):
+        where = f"failure.misses[{k}]"
+        if not isinstance(miss, dict) or not isinstance(miss.get("part"), str):
+            return f"{where}: expected an object with a part name, got {miss!r}"
+        dims = miss.get("dimensions")
+        if not isinstance(dims, list) or not set(dims) <= _DIMENSIONS:
+            return f"{where}.dimensions: expected some of {sorted(_DIMENSIONS)}, got {dims!r}"
+        excess = miss.get("excess")
+        if (
+            not isinstance(excess, list)
+            or len(excess) != 3
+            or not all(_is_number(e) and math.isfinite(e) for e in excess)
+        ):
+            return f"{where}.excess: expected three finite numbers, got {excess!r}"
+    return None
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 class RecordFile:
@@ -154,14 +221,21 @@ class RecordFile:
                 "rollouts cannot be mixed with this one's: use another record file or delete it"
             )
         records: dict[int, RolloutRecord] = {}
+        actions = _dig(header, ("plan", "actions"))
         for number, line in enumerate(lines[1:], start=2):
             if not line.strip():
                 continue
             try:
-                record = RolloutRecord.from_json(json.loads(line))
+                data = json.loads(line)
+                problem = _record_problem(data, actions)
+                record = None if problem else RolloutRecord.from_json(data)
             except (ValueError, KeyError, TypeError) as error:
+                problem = str(error)
+            if problem or record is None:
                 raise RecordFileError(
-                    f"{self.path}:{number}: not a rollout record: {error}"
+                    f"{self.path}:{number}: not a rollout record of this evaluation: {problem}; "
+                    "the file was edited or written by something else: use another record file "
+                    "or delete it"
                 ) from None
             earlier = records.get(record.index)
             if earlier is not None and earlier != record:

@@ -1,64 +1,193 @@
 """The experiments' raw measurements as CSV records, written so an interrupted run resumes.
 
 An experiment appends each row as soon as it is measured (:class:`CsvAppender`, flushed per
-row), and a rerun skips the rows whose key columns a previous run already wrote
-(:func:`done_keys`). Values read back are strings, as :class:`csv.DictReader` gives them.
+row), and a rerun skips the rows whose key columns a previous run already wrote (the
+appender's ``done``). The CSV gets the care of the evaluation's record files
+(:mod:`arrange_up.evaluation.records`):
+
+* it is locked while a run appends to it: a second run on the same file is refused
+  (:class:`CsvRecordsError`) rather than measuring the same keys again;
+* a last line cut off by a kill is dropped when the file is opened again;
+* a CSV with other columns, or made with other settings, is refused: the settings that
+  change a measurement without being a key column (node limits, rollouts, timeouts, ...) are
+  kept beside the CSV in ``NAME.settings.json`` and compared on every rerun (a CSV written
+  before settings were kept has none to compare; its first rerun records them);
+* a key is measured once: writing a row whose key is already in the file raises.
+
+Values read back are strings, as :class:`csv.DictReader` gives them.
 """
 
 from __future__ import annotations
 
 import csv
+import io
+import json
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
-__all__ = ["CsvAppender", "Progress", "done_keys", "mean", "read_csv"]
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not on POSIX: files are not locked
+    fcntl = None
+
+__all__ = [
+    "CsvAppender",
+    "CsvRecordsError",
+    "Progress",
+    "done_keys",
+    "mean",
+    "read_csv",
+    "settings_path",
+]
 
 #: Receives one line of progress text at a time.
 Progress = Callable[[str], None]
 
 
+class CsvRecordsError(ValueError):
+    """An experiment CSV that is in use by another run, has other columns, was made with other
+    settings, or would get a key measured twice."""
+
+
 def read_csv(path: Path) -> list[dict[str, str]]:
-    """Every row of the CSV at ``path``, keyed by its header."""
-    with Path(path).open(newline="") as handle:
-        return list(csv.DictReader(handle))
+    """Every row of the CSV at ``path``, keyed by its header (a cut-off last line left out)."""
+    text = Path(path).read_bytes().decode("utf-8")
+    return list(csv.DictReader(io.StringIO(_whole_lines(text), newline="")))
 
 
 def done_keys(path: Path, fields: Sequence[str]) -> set[tuple[str, ...]]:
     """The ``fields`` columns of every row already in ``path`` (none when it does not exist)."""
-    if not path.exists():
+    if not Path(path).exists():
         return set()
-    return {tuple(row[f] for f in fields) for row in read_csv(path)}
+    return {tuple(row[f] or "" for f in fields) for row in read_csv(path)}
+
+
+def settings_path(path: Path) -> Path:
+    """Where the settings of the CSV ``path`` are kept: ``NAME.settings.json`` beside it."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.settings.json")
+
+
+def _whole_lines(text: str) -> str:
+    """``text`` without a last line that was cut off (no line ending after it)."""
+    if text and not text.endswith("\n"):
+        return text[: text.rfind("\n") + 1]
+    return text
 
 
 class CsvAppender:
-    """A context manager appending rows to a CSV: the header is written once (when the file is
-    new or empty), and the file is flushed after every row.
+    """A context manager appending rows to a CSV (see the module docstring).
 
-    ``with CsvAppender(path, fields) as write: write(row)``.
+    ``with CsvAppender(path, fields, key=("problem", "run"), settings={...}) as write:``
+    locks the file, drops a cut-off last line, refuses other columns or settings, and gives
+    ``write.done`` (the keys already measured, as tuples of strings); ``write(row)`` appends a
+    row and flushes it, and raises :class:`CsvRecordsError` for a key already measured. The
+    header is written when the file is new or empty.
     """
 
-    def __init__(self, path: Path, fields: Sequence[str]) -> None:
+    def __init__(
+        self,
+        path: Path,
+        fields: Sequence[str],
+        *,
+        key: Sequence[str] = (),
+        settings: Mapping[str, Any] | None = None,
+    ) -> None:
         self.path = Path(path)
         self.fields = list(fields)
+        self.key = tuple(key)
+        self.settings = dict(settings or {})
+        self.done: set[tuple[str, ...]] = set()
 
-    def __enter__(self) -> Callable[[dict[str, Any]], None]:
+    def __enter__(self) -> CsvAppender:
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        new = not self.path.exists() or self.path.stat().st_size == 0
-        self.handle = self.path.open("a", newline="")
-        self.writer = csv.DictWriter(self.handle, self.fields)
-        if new:
+        self.handle: IO[bytes] = open(self.path, "a+b")  # noqa: SIM115 - closed by __exit__
+        try:
+            self._lock()
+            self._open()
+        except BaseException:
+            self.handle.close()
+            raise
+        return self
+
+    def _lock(self) -> None:
+        if fcntl is None:  # pragma: no cover - not on POSIX
+            return
+        try:
+            fcntl.flock(self.handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise CsvRecordsError(
+                f"{self.path}: the CSV is in use by another run of the experiment; wait for it "
+                "or write to another output directory"
+            ) from None
+
+    def _open(self) -> None:
+        self.handle.seek(0)
+        text = self.handle.read().decode("utf-8")
+        whole = _whole_lines(text)
+        if whole != text:  # a run killed while writing a row: drop the cut-off line
+            self.handle.truncate(len(whole.encode("utf-8")))
+        rows = list(csv.reader(io.StringIO(whole, newline="")))
+        if rows and rows[0] != self.fields:
+            raise CsvRecordsError(
+                f"{self.path}: its columns ({', '.join(rows[0])}) are not this experiment's "
+                f"({', '.join(self.fields)}); write to another output directory"
+            )
+        self._check_settings(has_rows=len(rows) > 1)
+        self.writer = csv.DictWriter(_Text(self.handle), self.fields)
+        if not rows:
             self.writer.writeheader()
-
-        def write(row: dict[str, Any]) -> None:
-            self.writer.writerow(row)
             self.handle.flush()
+        index = {name: k for k, name in enumerate(self.fields)}
+        for row in rows[1:]:
+            self.done.add(tuple(row[index[f]] if index[f] < len(row) else "" for f in self.key))
 
-        return write
+    def _check_settings(self, *, has_rows: bool) -> None:
+        where = settings_path(self.path)
+        if has_rows and where.exists():
+            try:
+                kept = json.loads(where.read_text(encoding="utf-8"))
+            except ValueError as error:
+                raise CsvRecordsError(f"{where}: not a settings file: {error}") from None
+            ours = json.loads(json.dumps(self.settings))
+            differ = sorted(k for k in set(kept) | set(ours) if kept.get(k) != ours.get(k))
+            if differ:
+                details = "; ".join(
+                    f"{k}: the CSV's {kept.get(k)!r}, this run's {ours.get(k)!r}" for k in differ
+                )
+                raise CsvRecordsError(
+                    f"{self.path}: its rows were measured with other settings ({details}); "
+                    "rows of different settings cannot be mixed: run with the CSV's settings or "
+                    "write to another output directory"
+                )
+            return
+        where.write_text(json.dumps(self.settings, indent=2, sort_keys=True) + "\n", "utf-8")
+
+    def __call__(self, row: dict[str, Any]) -> None:
+        key = tuple(str(row[f]) for f in self.key)
+        if self.key and key in self.done:
+            raise CsvRecordsError(
+                f"{self.path}: the row of {dict(zip(self.key, key, strict=True))} is already "
+                "measured; a key is measured once"
+            )
+        self.writer.writerow(row)
+        self.handle.flush()
+        self.done.add(key)
 
     def __exit__(self, *exc: object) -> None:
-        self.handle.close()
+        self.handle.close()  # also releases the lock
+
+
+class _Text:
+    """A text ``write`` over a binary handle, for :class:`csv.DictWriter`."""
+
+    def __init__(self, handle: IO[bytes]) -> None:
+        self.handle = handle
+
+    def write(self, text: str) -> int:
+        return self.handle.write(text.encode("utf-8"))
 
 
 def mean(values: Iterable[float]) -> float:

@@ -172,9 +172,7 @@ def fixture_experiment(
     workers = workers or available_cores()
     tries = max_tries if max_tries is not None else 10 * max(plans, 20) + 10
     path = Path(output_dir) / CSV_NAME
-    existing = read_csv(path) if path.exists() else []
     _check_columns(path)
-    done = done_keys(path, _KEY)
     say = progress or (lambda _msg: None)
 
     def evaluate(problem: Any, actions: Sequence[Any], what: str) -> dict[str, Any]:
@@ -201,11 +199,13 @@ def fixture_experiment(
             **{kind: getattr(result.failures, kind) for kind in FAILURE_KINDS},
         }
 
-    with CsvAppender(path, FIXTURE_FIELDS) as append:
+    settings = {"rollouts": rollouts, "timeout": timeout}
+    with CsvAppender(path, FIXTURE_FIELDS, key=_KEY, settings=settings) as append:
+        existing = read_csv(path)  # under the lock: what an earlier run measured
+        done = append.done  # grows as rows are written: a repeated problem or count is done too
 
         def write(row: dict[str, Any]) -> None:
             append(row)
-            done.add(_key(*(row[f] for f in _KEY)))  # a repeated problem or count is done too
             if measured is not None:
                 measured(row)
 

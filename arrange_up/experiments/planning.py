@@ -116,9 +116,10 @@ def transition_comparison(
     workers = workers or available_cores()
     planners = list(planners or default_planners())
     path = Path(output_dir) / "transition-comparison.csv"
-    done = done_keys(path, _TRANSITION_KEY)
     say = progress or (lambda _msg: None)
-    with CsvAppender(path, TRANSITION_FIELDS) as write:
+    settings = {"rollouts": rollouts, "max_nodes": max_nodes, "timeout": timeout}
+    with CsvAppender(path, TRANSITION_FIELDS, key=_TRANSITION_KEY, settings=settings) as write:
+        done = write.done  # grows as rows are written: a repeated planner is measured once
         for name in problems:
             problem = load(name)
             for planner in planners:
@@ -223,9 +224,15 @@ def search_table(
     ``progress`` gets a line as each search starts, ``measured`` each row as it is written;
     the PNG shows the rows of ``problems`` and ``semantics``."""
     path = Path(output_dir) / "search-table.csv"
-    done = done_keys(path, _SEARCH_KEY)
     say = progress or (lambda _msg: None)
-    with CsvAppender(path, SEARCH_FIELDS) as write:
+    settings = {
+        "particles": particles,
+        "max_nodes": max_nodes,
+        "weight": weight,
+        "timeout": timeout,
+    }
+    with CsvAppender(path, SEARCH_FIELDS, key=_SEARCH_KEY, settings=settings) as write:
+        done = write.done  # grows as rows are written: a repeated problem is measured once
         for label, heuristic in SEARCH_TYPES:
             for domination in (False, True):
                 for name in problems:

@@ -38,6 +38,13 @@ symmetry (a square block turned 90 degrees is the same block).
 
 **Units.** PDDL files are always in **inches and degrees** (the YAML format's defaults; degrees
 keep angles like 15 or 90 exact). Numbers are read exactly (``Fraction``) and converted once.
+A negative number is written the standard way, ``(- 15)`` (PDDL's numbers are unsigned, and
+strict parsers refuse ``-15``); the reader takes both forms.
+
+**Files written by unified-planning's PDDLWriter** from a problem ``PDDLReader`` read (problem
+``NAME-problem`` of domain ``NAME-domain``) are read as problem ``NAME`` of the arrange-up
+domain. PDDLWriter's output for the model of :func:`arrange_up.up.compile.to_up` is not (that
+model has no shapes); the refusal says to write the problem with :func:`write_pddl_problem`.
 
 **Names** are kept as written: unified-planning lowercases PDDL names (PDDL is
 case-insensitive), so :func:`load_pddl_problem` restores the case from the file's ``:objects``

@@ -33,6 +33,7 @@ __all__ = [
     "domain_path",
     "domain_pddl_text",
     "num",
+    "number_term",
 ]
 
 DOMAIN_NAME = "arrange-up"
@@ -124,14 +125,14 @@ _DOMAIN_TEMPLATE = """\
   )
 
   (:predicates
-    (on-table ?o - object)   ; in :init, the object starts on the table
+    (on-table ?o)   ; in :init, the object starts on the table
     (wall-left) (wall-right) (wall-bottom) (wall-top)   ; rigid walls along the table's edges
   )
 
   (:functions
     ; nominal pose (x, y in inches; theta in degrees) of an object on the table at the start,
     ; or of an obstacle; the pose refers to the shape's area centroid
-    (x ?o - object) (y ?o - object) (theta ?o - object)
+    (x ?o) (y ?o) (theta ?o)
     ; half-widths of the initial uncertainty: the pose lies in x +- dx, y +- dy, theta +- dtheta
     (dx ?o - movable) (dy ?o - movable) (dtheta ?o - movable)
     ; pose of part ?p in the frame of part ?r (relative goals)
@@ -174,6 +175,13 @@ _DOMAIN_TEMPLATE = """\
 def num(value: float) -> str:
     """A number as a plain PDDL decimal (no exponent), to 12 significant digits."""
     return decimal_text(Decimal(f"{float(value):.12g}"))
+
+
+def number_term(text: str) -> str:
+    """A number written by :func:`num` or :func:`decimal_text` as a PDDL term: a negative
+    number as the standard ``(- 15)`` (PDDL's numbers are unsigned; strict parsers refuse
+    ``-15``)."""
+    return f"(- {text[1:]})" if text.startswith("-") else text
 
 
 def decimal_text(value: Decimal) -> str:

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -127,7 +128,9 @@ def _check_text(text: str, source: str, domain: str | Path | None) -> Checked:
     domain_text = domain_file.read_text(encoding="utf-8")
     located = _Text(text)
     declared = located.domain_name()
-    if declared is not None and declared.lower() != DOMAIN_NAME:
+    foreign = declared is not None and declared.lower() != DOMAIN_NAME
+    if foreign and located.up_writer_name() is None:
+        assert declared is not None
         line, column = located.find(r"\(\s*:domain\s+" + re.escape(declared))
         raise ProblemFormatError(
             [
@@ -137,17 +140,30 @@ def _check_text(text: str, source: str, domain: str | Path | None) -> Checked:
                     column,
                     ":domain",
                     f"the problem is for domain {declared!r}; expected {DOMAIN_NAME!r} "
-                    f"(arrange-up reads problems of its own domain, {DOMAIN_FILE})",
+                    f"(arrange-up reads problems of its own domain, {DOMAIN_FILE}, and what "
+                    "unified-planning's PDDLWriter writes of one: problem NAME-problem for "
+                    "domain NAME-domain)",
                 )
             ]
         )
     try:
         up_problem = PDDLReader().parse_problem_string(domain_text, text)
     except Exception as error:  # UP raises many kinds; each becomes one diagnostic
-        raise ProblemFormatError([_reader_diagnostic(error, source, located)]) from None
+        diagnostic = _reader_diagnostic(error, source, located)
+        if located.up_writer_name() is not None:
+            diagnostic = dataclasses.replace(diagnostic, message=diagnostic.message + _UP_WRITER)
+        raise ProblemFormatError([diagnostic]) from None
     builder = _Builder(up_problem, source, located)
     problem = builder.build()
     return problem, sort_diagnostics(builder.diagnostics)
+
+
+_UP_WRITER = (
+    "; the file looks written by unified-planning's PDDLWriter, which arrange-up reads when it "
+    "wrote a problem of arrange-up's PDDL domain (one PDDLReader read from a .pddl file). The "
+    "model of arrange_up.up.compile.to_up has no shapes and other names: write its arrangement "
+    "problem with arrange_up.io.pddl.write_pddl_problem instead"
+)
 
 
 def problem_from_up(
@@ -194,6 +210,17 @@ class _Text:
     def problem_name(self) -> str | None:
         match = re.search(r"\(\s*problem\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
         return match.group(1) if match else None
+
+    def up_writer_name(self) -> str | None:
+        """``NAME`` when the problem is ``NAME-problem`` of domain ``NAME-domain``, the names
+        unified-planning's ``PDDLWriter`` gives a problem ``NAME`` and its domain."""
+        domain, problem = self.domain_name(), self.problem_name()
+        if domain is None or problem is None:
+            return None
+        stem = domain[: -len("-domain")]
+        if domain.lower().endswith("-domain") and problem.lower() == f"{stem}-problem".lower():
+            return problem[: -len("-problem")]
+        return None
 
     def object_names(self) -> list[str]:
         """Object names in the ``:objects`` section, as written, in order."""
@@ -305,7 +332,7 @@ class _Builder:
         )
         name = self.up.name
         if self.located is not None:
-            name = self.located.problem_name() or name
+            name = self.located.up_writer_name() or self.located.problem_name() or name
         problem = ArrangementProblem(
             name=name,
             table=table,
@@ -363,12 +390,22 @@ class _Builder:
         out: dict[tuple[str, ...], Any] = {}
         for fluent_exp, value in self.up.explicit_initial_values.items():
             key = (fluent_exp.fluent().name, *(self.name(a.object().name) for a in fluent_exp.args))
+            # a negative number is (- 15) in standard PDDL, an expression to UP: simplify it
+            value = value.simplify()
             if value.is_bool_constant():
                 out[key] = value.bool_constant_value()
-                continue
-            number = Fraction(value.constant_value())
-            if self.finite(number, f"init.{key[0]}", _fluent_pattern(key)):
-                out[key] = number
+            elif value.is_int_constant() or value.is_real_constant():
+                number = Fraction(value.constant_value())
+                if self.finite(number, f"init.{key[0]}", _fluent_pattern(key)):
+                    out[key] = number
+            else:
+                function = key[0]
+                self.error(
+                    f"init.{function}",
+                    rf"\(\s*=\s*\(\s*{re.escape(function)}[\s)]",
+                    f"({' '.join(key)}) is set to {value}; expected a number (a negative one "
+                    "written -15 or (- 15))",
+                )
         return out
 
     def finite(self, number: Fraction, path: str, pattern: str) -> bool:
@@ -696,7 +733,8 @@ class _Builder:
         if condition.is_fluent_exp() and condition.fluent().name == "on-table":
             return "on-table"
         if condition.is_le() or condition.is_lt() or condition.is_equals():
-            left, right = condition.args
+            # a bound written (- 0.6) is an expression to UP: simplify it to its number
+            left, right = (arg.simplify() for arg in condition.args)
             if left.is_fluent_exp() and right.is_constant():
                 fluent, value, side = left, Fraction(right.constant_value()), "high"
             elif right.is_fluent_exp() and left.is_constant():

@@ -19,6 +19,7 @@ from arrange_up.io.pddl_domain import (
     VOCABULARY,
     decimal_text,
     num,
+    number_term,
 )
 from arrange_up.io.shape_catalogue import PDDL_NAME, Catalogue, load_catalogue
 from arrange_up.model.problem import ArrangementProblem, PlanningHints
@@ -129,7 +130,9 @@ def _render(problem: ArrangementProblem, types: dict[str, str]) -> str:
     table = problem.table
     walls = ", ".join(table.walls) if table.walls else "none"
     lines.append(f"    ; the table, {num(table.width)} x {num(table.depth)} in; walls: {walls}")
-    lines.append(f"    (= (table-width) {num(table.width)}) (= (table-depth) {num(table.depth)})")
+    lines.append(
+        f"    (= (table-width) {_term(table.width)}) (= (table-depth) {_term(table.depth)})"
+    )
     if table.walls:
         lines.append("    " + " ".join(f"(wall-{edge})" for edge in table.walls))
     unc = problem.uncertainty
@@ -137,7 +140,7 @@ def _render(problem: ArrangementProblem, types: dict[str, str]) -> str:
     noise = []
     for name, (attr, index) in NOISE_FUNCTIONS.items():
         value = getattr(unc, attr)[index]
-        noise.append(f"(= ({name}) {num(deg(value) if name.endswith('theta') else value)})")
+        noise.append(f"(= ({name}) {_term(deg(value) if name.endswith('theta') else value)})")
     lines += ["    " + " ".join(noise[:3]), "    " + " ".join(noise[3:6])]
     lines += ["    " + " ".join(noise[i : i + 2]) for i in (6, 8, 10)]
     obstacles = problem.obstacles
@@ -152,8 +155,8 @@ def _render(problem: ArrangementProblem, types: dict[str, str]) -> str:
             lines.append(f"    (on-table {entry.name}) {_pose_facts(entry.name, entry.pose)}")
             dx, dy, dtheta = entry.uncertainty
             lines.append(
-                f"      (= (dx {entry.name}) {num(dx)}) (= (dy {entry.name}) {num(dy)}) "
-                f"(= (dtheta {entry.name}) {num(deg(dtheta))})"
+                f"      (= (dx {entry.name}) {_term(dx)}) (= (dy {entry.name}) {_term(dy)}) "
+                f"(= (dtheta {entry.name}) {_term(deg(dtheta))})"
             )
     lines += ["  )", "  (:goal (and"]
     goal = problem.goal
@@ -177,14 +180,19 @@ def _render(problem: ArrangementProblem, types: dict[str, str]) -> str:
 def _pose_facts(name: str, pose: tuple[float, float, float]) -> str:
     x, y, theta = pose
     return (
-        f"(= (x {name}) {num(x)}) (= (y {name}) {num(y)}) "
-        f"(= (theta {name}) {num(PDDL_UNITS.angle_out(theta))})"
+        f"(= (x {name}) {_term(x)}) (= (y {name}) {_term(y)}) "
+        f"(= (theta {name}) {_term(PDDL_UNITS.angle_out(theta))})"
     )
 
 
 def _interval(fluent: str, target: float, tol: float) -> str:
     t, d = Decimal(num(target)), Decimal(num(tol))
-    return f"(>= {fluent} {decimal_text(t - d)}) (<= {fluent} {decimal_text(t + d)})"
+    low, high = number_term(decimal_text(t - d)), number_term(decimal_text(t + d))
+    return f"(>= {fluent} {low}) (<= {fluent} {high})"
+
+
+def _term(value: float) -> str:
+    return number_term(num(value))
 
 
 def _comment_block(text: str, width: int = 96) -> list[str]:

@@ -12,6 +12,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
+from pathlib import Path
 from typing import Any
 
 from arrange_up.model.problem import ArrangementProblem
@@ -159,6 +160,7 @@ def plan(
     variety: bool = False,
     progress: ProgressCallback | None = None,
     should_stop: Callable[[], bool] | None = None,
+    model: str | Path | None = None,
 ) -> PlanResult:
     """Search for a conformant plan for ``problem``.
 
@@ -207,6 +209,10 @@ def plan(
         :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end.
     should_stop
         Polled during the search; returning True cancels it (status ``cancelled``).
+    model
+        The learned model of a semantics that has one (``cbst``: a shipped name or the card
+        of a model ``arrange-up train-cbst`` made); ``None``: the shipped default. A model for
+        another semantics, or one that does not load, raises ``ValueError``.
     """
     started = time.monotonic()
     limit = (
@@ -221,6 +227,7 @@ def plan(
         heuristic=heuristic,
         dominance=dominance,
         variety=variety,
+        model=model,
     )
 
     def report(stats: SearchStats) -> None:

@@ -14,6 +14,7 @@ import dataclasses
 import hashlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -73,13 +74,16 @@ class BeliefTask:
         heuristic: str,
         dominance: bool,
         variety: bool,
+        model: str | Path | None = None,
     ) -> BeliefTask:
         """The task of :func:`~arrange_up.planning.planner.plan`'s arguments of the same names.
 
         The semantics is instantiated first (it may start worker processes); it is closed
         again if building the rest fails.
         """
-        model = make_semantics(semantics, problem, particles=particles, seed=seed, workers=workers)
+        model = make_semantics(
+            semantics, problem, particles=particles, seed=seed, workers=workers, model=model
+        )
         try:
             checker = CollisionChecker(problem)
             goal = GoalTest(problem)

@@ -15,7 +15,9 @@ New semantics register themselves with :func:`register`.
 from __future__ import annotations
 
 import importlib
+import inspect
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, Protocol
 
 from arrange_up.model.problem import ArrangementProblem
@@ -83,13 +85,26 @@ def make_semantics(
     particles: int = 50,
     seed: int = 0,
     workers: int = 1,
+    model: str | Path | None = None,
 ) -> Semantics:
     """Instantiate the named semantics for ``problem``.
 
-    Raises ``ValueError`` naming the registered semantics when ``name`` is unknown.
+    ``model`` selects the learned model of a semantics that has one (``cbst``: a shipped name
+    or a model card's path, see :func:`arrange_up.cbst.model.load_model`); ``None`` leaves the
+    semantics' default.
+
+    Raises ``ValueError`` naming the registered semantics when ``name`` is unknown, and when a
+    ``model`` is given to a semantics without one.
     """
     if name not in _REGISTRY:
         raise ValueError(f"unknown semantics {name!r}; expected one of {', '.join(_REGISTRY)}")
     module, attribute = _REGISTRY[name]
     factory = getattr(importlib.import_module(module), attribute)
-    return factory(problem, particles=particles, seed=seed, workers=workers)
+    if model is None:
+        return factory(problem, particles=particles, seed=seed, workers=workers)
+    if "model" not in inspect.signature(factory).parameters:
+        raise ValueError(
+            f"the {name} semantics has no learned model to select (a model, such as one "
+            "train-cbst makes, is for the cbst semantics)"
+        )
+    return factory(problem, particles=particles, seed=seed, workers=workers, model=model)

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 
@@ -85,7 +86,7 @@ class CBSTSemantics:
         particles: int = 2,
         seed: int = 0,
         workers: int = 1,
-        model: str = "default",
+        model: str | Path = "default",
     ) -> None:
         self.problem = problem
         self.particles = 2

@@ -366,13 +366,20 @@ def plan_to_up(up_problem: Any, actions: Sequence[Action]) -> Any:
     return SequentialPlan(out, environment=up_problem.environment)
 
 
-def plan_from_up(plan: Any) -> tuple[Action, ...]:
+def plan_from_up(plan: Any, problem: ArrangementProblem | None = None) -> tuple[Action, ...]:
     """The arrange-up actions (inches, radians) of a UP ``SequentialPlan`` over the model of
     :func:`to_up`.
+
+    With ``problem``, an object name the problem does not have is read as the problem's one
+    object of that name in another case: PDDL names are case-insensitive and unified-planning's
+    ``PDDLReader`` lowercases them, so a plan solved from a PDDL-read problem names ``t`` what
+    the file (and :func:`arrange_up.io.pddl.load_pddl_problem`) names ``T``. A name matching
+    no object, or several, is kept as it is (the evaluation then reports it).
 
     Raises ``ValueError`` for another kind of plan, or an action that is not ``place``,
     ``push`` or ``pick`` with the parameters :func:`to_up` gives them (an object, then
     numbers)."""
+    name_of = _object_names(problem)
     if not isinstance(plan, SequentialPlan):
         raise ValueError(
             f"a {type(plan).__name__} is not a sequential plan; expected a SequentialPlan of "
@@ -394,16 +401,36 @@ def plan_from_up(plan: Any) -> tuple[Action, ...]:
                 f"action {k + 1}, {instance}, does not have the parameters of arrange-up's "
                 f"{name} (an object, then {arity - 1} numbers)"
             )
+        obj = name_of(params[0].object().name)
         if name == "pick":
-            out.append(Pick(params[0].object().name))
+            out.append(Pick(obj))
             continue
         x, y, theta = (float(p.constant_value()) for p in params[1:4])
         pose = (x, y, math.radians(theta))
         if name == "place":
-            out.append(Place(params[0].object().name, pose))
+            out.append(Place(obj, pose))
         else:
-            out.append(Push(params[0].object().name, pose, float(params[4].constant_value())))
+            out.append(Push(obj, pose, float(params[4].constant_value())))
     return tuple(out)
+
+
+def _object_names(problem: ArrangementProblem | None) -> Any:
+    """``name -> name`` of ``problem``'s object named so, or else its one object of that name
+    in another case (see :func:`plan_from_up`)."""
+    if problem is None:
+        return lambda name: name
+    exact = {spec.name for spec in problem.objects}
+    folded: dict[str, list[str]] = {}
+    for spec in problem.objects:
+        folded.setdefault(spec.name.lower(), []).append(spec.name)
+
+    def name_of(name: str) -> str:
+        if name in exact:
+            return name
+        matches = folded.get(name.lower(), [])
+        return matches[0] if len(matches) == 1 else name
+
+    return name_of
 
 
 #: The number of parameters of each action of :func:`to_up`'s model.

@@ -20,7 +20,11 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
 * ``SOLVED_SATISFICING``: a ``SequentialPlan`` of ``place``/``push``/``pick`` instances with
   exact ``Fraction`` real parameters (inches, degrees). For a problem read from PDDL, whose
   actions cannot carry real parameters, the instances belong to ``to_up`` of the same problem
-  (a log message says so).
+  (a log message says so), with the names as ``PDDLReader`` read them (lowercase). The
+  validator and the repairer read a plan's object names case-insensitively where the problem
+  has no object of the exact name (PDDL names are case-insensitive), so such a plan is judged
+  against ``to_up(load_pddl_problem(file))`` too; ``plan_from_up(plan, problem)`` names its
+  actions' objects as ``problem`` does, for any other use.
 * ``UNSOLVABLE_INCOMPLETELY``: the node limit was reached, or the search space was exhausted
   under pruning (the search is incomplete, so nothing is proven).
 * ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
@@ -29,7 +33,9 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
   planner failed, or reading the problem did. Both with a log message saying why.
 
 Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` (default
-``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000).
+``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000),
+``model`` (``cbst`` only: a shipped model name or the card path of a model ``arrange-up
+train-cbst`` made; default the shipped one; it is loaded and checked when the engine is made).
 Metrics hold the search statistics (expanded, generated, evaluated, pruned, elapsed, ...).
 
 **The reliability validator** (:class:`ArrangeUpReliability`) judges a plan by Monte Carlo
@@ -344,7 +350,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
     """Conformant belief-space planning for arrange-up problems (see the module doc)."""
 
     _NAME = ENGINE_NAME
-    _PARAMETERS = ("semantics", "particles", "seed", "max_nodes")
+    _PARAMETERS = ("semantics", "particles", "seed", "max_nodes", "model")
 
     def __init__(
         self,
@@ -352,16 +358,18 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
         particles: int = 50,
         seed: int = 0,
         max_nodes: int | None = None,
+        model: str | None = None,
         **unknown: Any,
     ) -> None:
         self._refuse_unknown(unknown)
         Engine.__init__(self)
         OneshotPlannerMixin.__init__(self)
-        _check_params(semantics, particles, seed, max_nodes)
+        _check_params(semantics, particles, seed, max_nodes, model)
         self._semantics = semantics
         self._particles = particles
         self._seed = seed
         self._max_nodes = max_nodes
+        self._model = model
 
     @staticmethod
     def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
@@ -441,6 +449,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
                 timeout=None if deadline is None else max(0.0, deadline - time.monotonic()),
                 progress=progress,
                 should_stop=out_of_time,
+                model=self._model,
             )
         except Exception as error:  # the engine must answer, not raise
             return result(
@@ -489,7 +498,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
         return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)
 
 
-def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any) -> None:
+def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any, model: Any) -> None:
     if semantics not in available():
         raise ValueError(
             f"arrange-up: unknown semantics {semantics!r}; expected one of {', '.join(available())}"
@@ -502,6 +511,24 @@ def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any) -> 
         not isinstance(max_nodes, int) or isinstance(max_nodes, bool) or max_nodes < 1
     ):
         raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
+    if model is not None:
+        if semantics != "cbst":
+            raise ValueError(
+                f"arrange-up: model selects the cbst semantics' learned model; the {semantics} "
+                "semantics has none"
+            )
+        if not isinstance(model, str):
+            raise ValueError(
+                f"arrange-up: model must be a shipped model name or a card path, got {model!r}"
+            )
+        # Lazy: the model room imports scikit-learn, which the engines need only for cbst
+        # (at module level it would add 0.13 s, measured, to importing this module).
+        from arrange_up.cbst.model import load_model
+
+        try:
+            load_model(model)  # a model that does not load is refused when the engine is made
+        except (LookupError, ValueError) as error:
+            raise ValueError(f"arrange-up: model {model!r}: {error}") from None
 
 
 def _plan_to_up(
@@ -549,7 +576,7 @@ def _read_problem_and_plan(
     if isinstance(arrangement, _Refusal):
         return arrangement
     try:
-        actions = plan_from_up(plan)
+        actions = plan_from_up(plan, arrangement)
     except ValueError as error:
         return _Refusal(f"not a sequential plan of place/push/pick actions: {error}")
     except Exception as error:  # plan_from_up refuses foreign plans with ValueError

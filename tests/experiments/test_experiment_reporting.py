@@ -100,9 +100,15 @@ def test_tables_and_plots_show_only_the_rows_asked_for_with_node_limits(tmp_path
         ("blocks-1", "solved"),
         ("blocks-2", "node-limit"),
     ]
-    # A later call on blocks-1 alone: its plot and table leave blocks-2 out.
+    # A later call on blocks-1 alone (the CSV's settings): its plot and table leave blocks-2 out.
     transition_comparison(
-        tmp_path, problems=("blocks-1",), planners=PLANNERS[:1], runs=1, rollouts=2, workers=1
+        tmp_path,
+        problems=("blocks-1",),
+        planners=PLANNERS[:1],
+        runs=1,
+        rollouts=2,
+        max_nodes=4,
+        workers=1,
     )
     rows = select_transition_rows(read_csv(path), ["blocks-1"], ["deterministic"], 1)
     assert [r["problem"] for r in rows] == ["blocks-1"]

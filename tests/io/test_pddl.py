@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from pathlib import Path
 
@@ -236,3 +237,89 @@ def test_the_pddl_reader_warns_as_the_yaml_reader_does():
     assert len(warnings) == 2 and all(": warning: " in w for w in warnings)
     assert "b1.pddl:27:32:" in warnings[0] and "(friction-max) is 1000000" in warnings[0]
     assert "b1.pddl:31:" in warnings[1] and "at its goal pose A spans x 9.2..10.2" in warnings[1]
+
+
+# -- numbers: standard PDDL writes a negative number as (- 15) --------------------------------
+EXPRESSIBLE = [name for name in domain_names() if _expressible(name)]
+
+
+def _signed_literals(text: str) -> str:
+    """``text`` with ``(- 15)`` written the non-standard way, ``-15`` (files written before)."""
+    return re.sub(r"\(- ([0-9.]+)\)", r"-\1", text)
+
+
+@pytest.mark.parametrize("name", EXPRESSIBLE)
+def test_a_second_pddl_parser_reads_every_export(name, tmp_path: Path):
+    strict = pytest.importorskip("pddl")
+    domain = strict.parse_domain(domain_path())
+    assert domain.name == "arrange-up"
+    exported = tmp_path / f"{name}.pddl"
+    exported.write_text(write_pddl_problem(load(name)), encoding="utf-8")
+    for path in (exported, *(domains_dir() / f"{n}.pddl" for n in SHIPPED_PDDL if n == name)):
+        parsed = strict.parse_problem(path)
+        assert parsed.name == name
+        assert {str(o.name) for o in parsed.objects} == {s.name for s in load(name).objects}
+
+
+def test_negative_numbers_are_written_as_standard_pddl():
+    text = write_pddl_problem(load("tz-mating"))
+    assert "(>= (rel-y Z T) (- 0.6)) (<= (rel-y Z T) (- 0.2))" in text
+    code = re.sub(r";[^\n]*", "", text)
+    assert not re.search(r"(?<![(\w])-\d", code)  # no signed literal outside comments
+
+
+@pytest.mark.parametrize("name", EXPRESSIBLE)
+def test_both_forms_of_a_negative_number_load_the_same_problem(name):
+    text = write_pddl_problem(load(name))
+    written = load_pddl_problem_text(text, "new.pddl")
+    before = load_pddl_problem_text(_signed_literals(text), "old.pddl")
+    assert problem_hash(written) == problem_hash(before) == problem_hash(load(name))
+
+
+def test_a_negative_initial_angle_and_goal_bound_in_standard_form_load():
+    text = write_pddl_problem(load("tz-mating")).replace(
+        "(= (theta Z) 90)", "(= (theta Z) (- 270))"
+    )
+    problem = load_pddl_problem_text(text, "tz.pddl")
+    (z,) = (entry for entry in problem.initial if entry.name == "Z")
+    assert z.pose[2] == pytest.approx(math.radians(-270))
+    assert dict(problem.goal.targets)["Z"][1] == pytest.approx(-0.4)
+
+
+def test_a_non_numeric_initial_value_is_refused_with_its_place():
+    text = (
+        (domains_dir() / "blocks-1.pddl")
+        .read_text()
+        .replace("(= (table-width) 10)", "(= (table-width) (* (table-depth) 2))")
+    )
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "b1.pddl")
+    message = str(caught.value)
+    assert "b1.pddl:" in message and "expected a number" in message
+
+
+# -- what unified-planning's PDDLWriter writes ---------------------------------------------
+@pytest.mark.parametrize("name", SHIPPED_PDDL)
+def test_pddl_written_by_unified_planning_is_read(name, tmp_path: Path):
+    from unified_planning.io import PDDLWriter
+
+    up = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / f"{name}.pddl"))
+    path = tmp_path / "written.pddl"
+    path.write_text(PDDLWriter(up).get_problem(), encoding="utf-8")
+    problem = load_pddl_problem(path)
+    assert problem.name == name  # not PDDLWriter's NAME-problem
+    assert problem_hash(problem) == problem_hash(from_up(up))
+    assert load(str(path)).name == name
+
+
+def test_pddl_written_from_the_to_up_model_is_refused_with_what_to_do(tmp_path: Path):
+    from unified_planning.io import PDDLWriter
+
+    from arrange_up.up.compile import to_up
+
+    path = tmp_path / "written.pddl"
+    path.write_text(PDDLWriter(to_up(load("blocks-1"))).get_problem(), encoding="utf-8")
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem(path)
+    message = str(caught.value)
+    assert str(path) in message and "write_pddl_problem" in message

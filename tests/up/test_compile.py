@@ -198,3 +198,34 @@ def test_from_up_refuses_every_example_problem_of_unified_planning_with_value_er
     scheduling = get_example_problems()["sched:basic"].problem
     with pytest.raises(ValueError, match="a unified-planning SchedulingProblem is not an arrange"):
         from_up(scheduling)
+
+
+def test_plan_from_up_names_objects_as_the_problem_does():
+    """PDDL names are case-insensitive: a plan over lowercase names reads against the problem's
+    written case, and an exact name wins."""
+    problem = load("blocks-2")  # A, B, paddle
+    lower = dataclasses.replace(
+        problem,
+        objects=tuple(dataclasses.replace(s, name=s.name.lower()) for s in problem.objects),
+        initial=tuple(dataclasses.replace(e, name=e.name.lower()) for e in problem.initial),
+        goal=dataclasses.replace(
+            problem.goal, targets=tuple((p.lower(), t) for p, t in problem.goal.targets)
+        ),
+    )
+    up = to_up(lower)
+    plan = plan_to_up(up, [Place("a", (1.0, 1.0, 0.0)), Pick("b")])
+    assert [a.obj for a in plan_from_up(plan)] == ["a", "b"]
+    assert [a.obj for a in plan_from_up(plan, problem)] == ["A", "B"]
+    assert [a.obj for a in plan_from_up(plan, lower)] == ["a", "b"]
+    two = dataclasses.replace(
+        problem, objects=(*problem.objects, dataclasses.replace(problem.objects[0], name="a"))
+    )
+    assert [a.obj for a in plan_from_up(plan, two)] == ["a", "B"]
+    both = dataclasses.replace(
+        problem,
+        objects=tuple(
+            dataclasses.replace(s, name=n)
+            for s, n in zip(problem.objects, ["A", "b", "B"], strict=True)
+        ),
+    )
+    assert [a.obj for a in plan_from_up(plan, both)] == ["A", "b"]

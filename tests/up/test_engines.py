@@ -29,6 +29,7 @@ from arrange_up.up.compile import from_up, to_up
 engines.register()  # idempotent; works before or after unified_planning is imported
 
 DETERMINISTIC = {"semantics": "deterministic", "seed": 0}
+ROLLOUTS = {"rollouts": 8, "seed": 0, "workers": 1}
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -282,3 +283,39 @@ def test_the_example_runs(capsys):
         assert module["main"]("blocks-1") == 0
     out = capsys.readouterr().out
     assert "SOLVED_SATISFICING" in out and "validator: VALID" in out
+
+
+def test_a_plan_solved_from_pddl_is_validated_against_the_file_as_arrange_up_loads_it():
+    from arrange_up.io.pddl import load_pddl_problem
+    from arrange_up.up.compile import plan_from_up, plan_to_up
+
+    path = domains_dir() / "blocks-2.pddl"
+    up = PDDLReader().parse_problem(str(domain_path()), str(path))
+    with pytest.warns(UserWarning):
+        result = _solve(up)
+    assert {i.actual_parameters[0].object().name for i in result.plan.actions} <= {
+        "a",
+        "b",
+        "paddle",
+    }  # PDDLReader lowercases the file's A and B
+    held = load_pddl_problem(path)  # the written case: A, B
+    verdicts = []
+    for target in (up, to_up(held)):
+        with PlanValidator(name="arrange-up-reliability", params=ROLLOUTS) as validator:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # PDDL-read problems are not offered by kind
+                check = validator.validate(target, result.plan)
+        assert check.status is not ValidationResultStatus.UNKNOWN, check.log_messages
+        verdicts.append((check.status, check.metrics["successes"], check.metrics["trials"]))
+    assert verdicts[0] == verdicts[1]  # the same problem, whichever case its names are in
+    # the plan's actions, named as the held problem names its objects, for UP's own validator
+    actions = plan_from_up(result.plan, held)
+    assert {getattr(a, "obj", getattr(a, "manipulator", None)) for a in actions} <= {
+        "A",
+        "B",
+        "paddle",
+    }
+    compiled = to_up(held)
+    with PlanValidator(name="sequential_plan_validator") as validator:
+        check = validator.validate(compiled, plan_to_up(compiled, actions))
+    assert check.status is ValidationResultStatus.VALID

@@ -1,0 +1,148 @@
+"""Tests of arrange_up.experiments.csv_records: the experiments' CSVs get the record files'
+care (a lock, a cut-off line dropped, other columns and settings refused, a key measured
+once)."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from arrange_up.cli import main
+from arrange_up.experiments.csv_records import (
+    CsvAppender,
+    CsvRecordsError,
+    done_keys,
+    read_csv,
+    settings_path,
+)
+from arrange_up.experiments.planning import Planner, transition_comparison
+
+FIELDS = ["problem", "run", "value"]
+KEY = ("problem", "run")
+SETTINGS = {"rollouts": 4, "max_nodes": 10, "timeout": None}
+
+
+def _appender(path: Path, settings=SETTINGS) -> CsvAppender:
+    return CsvAppender(path, FIELDS, key=KEY, settings=settings)
+
+
+def test_rows_are_appended_resumed_and_settings_kept(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    with _appender(path) as write:
+        assert write.done == set()
+        write({"problem": "p", "run": 0, "value": 1.5})
+    with _appender(path) as write:
+        assert write.done == {("p", "0")}
+        write({"problem": "p", "run": 1, "value": 2})
+    assert [r["run"] for r in read_csv(path)] == ["0", "1"]
+    assert settings_path(path).name == "t.settings.json"
+    assert settings_path(path).exists()
+
+
+def test_a_second_writer_is_refused_while_the_first_writes(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    with _appender(path) as write:
+        write({"problem": "p", "run": 0, "value": 1})
+        # another process: flock locks are held per open file, across processes
+        code = (
+            "import sys\n"
+            "from arrange_up.experiments.csv_records import CsvAppender, CsvRecordsError\n"
+            f"try:\n    CsvAppender({str(path)!r}, {FIELDS!r}, key={KEY!r}).__enter__()\n"
+            "except CsvRecordsError as e:\n    print(e); sys.exit(3)\n"
+        )
+        done = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, check=False
+        )
+        assert done.returncode == 3, done.stderr
+        assert "in use by another run" in done.stdout
+    with _appender(path) as write:  # released on exit
+        assert write.done == {("p", "0")}
+
+
+def test_a_key_is_measured_once(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    with _appender(path) as write:
+        write({"problem": "p", "run": 0, "value": 1})
+        with pytest.raises(CsvRecordsError, match="already measured"):
+            write({"problem": "p", "run": "0", "value": 2})
+    assert len(read_csv(path)) == 1
+
+
+def test_a_cut_off_last_line_is_dropped(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    with _appender(path) as write:
+        write({"problem": "p", "run": 0, "value": 1})
+        write({"problem": "p", "run": 1, "value": 2})
+    text = path.read_text()
+    path.write_text(text[: text.rindex("p,1") + 4])  # killed while writing row 1
+    assert [r["run"] for r in read_csv(path)] == ["0"]
+    assert done_keys(path, KEY) == {("p", "0")}
+    with _appender(path) as write:
+        assert write.done == {("p", "0")}
+        write({"problem": "p", "run": 1, "value": 2})
+    with path.open(newline="") as handle:
+        assert list(csv.reader(handle)) == [FIELDS, ["p", "0", "1"], ["p", "1", "2"]]
+
+
+def test_other_columns_or_settings_are_refused(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    with _appender(path) as write:
+        write({"problem": "p", "run": 0, "value": 1})
+    with pytest.raises(CsvRecordsError, match=r"max_nodes: the CSV's 10, this run's 20"):
+        with _appender(path, {**SETTINGS, "max_nodes": 20}):
+            pass
+    with pytest.raises(CsvRecordsError, match="columns"):
+        with CsvAppender(path, ["problem", "run"], key=KEY, settings=SETTINGS):
+            pass
+    assert len(read_csv(path)) == 1  # nothing written by the refused runs
+
+
+PLANNERS = [Planner("deterministic", "deterministic", 1)]
+
+
+def test_a_planner_given_twice_is_measured_once(tmp_path: Path):
+    measured: list[dict] = []
+    path = transition_comparison(
+        tmp_path,
+        problems=("blocks-1", "blocks-1"),
+        planners=PLANNERS * 2,
+        runs=1,
+        rollouts=0,
+        workers=1,
+        measured=measured.append,
+    )
+    assert len(measured) == 1
+    assert [(r["problem"], r["planner"], r["run"]) for r in read_csv(path)] == [
+        ("blocks-1", "deterministic", "0")
+    ]
+
+
+def test_a_rerun_with_a_cut_off_line_resumes_and_other_settings_exit_2(tmp_path: Path):
+    kwargs = {"problems": ("blocks-1",), "planners": PLANNERS, "runs": 2, "workers": 1}
+    path = transition_comparison(tmp_path, rollouts=0, **kwargs)
+    text = path.read_text()
+    path.write_text(text[: len(text) - 5])  # the last row cut off by a kill
+    transition_comparison(tmp_path, rollouts=0, **kwargs)
+    assert [r["run"] for r in read_csv(path)] == ["0", "1"]
+    result = CliRunner().invoke(
+        main,
+        [
+            "experiment",
+            "transition-comparison",
+            "--problems",
+            "blocks-1",
+            "--runs",
+            "2",
+            "--rollouts",
+            "3",
+            "--output-dir",
+            str(tmp_path),
+        ],
+    )
+    assert result.exit_code == 2, result.output
+    assert "other settings" in result.output and "rollouts" in result.output
