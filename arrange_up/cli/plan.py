@@ -89,6 +89,11 @@ def _status_line(stats: dict[str, Any]) -> str:
     help="Processes simulating particles (default: all cores; 1 for deterministic).",
 )
 @click.option(
+    "--model",
+    default=None,
+    help="CBST model (--semantics cbst): a shipped name or the .json card train-cbst wrote.",
+)
+@click.option(
     "--output",
     "-o",
     type=OutputFile(),
@@ -107,6 +112,7 @@ def plan(
     weight: float,
     no_dominance: bool,
     workers: int | None,
+    model: str | None,
     output: str | None,
     as_json: bool,
 ) -> None:
@@ -146,7 +152,12 @@ def plan(
                 dominance=not no_dominance,
                 workers=workers,
                 progress=update,
+                model=model,
             )
+    except (LookupError, ValueError) as error:  # a --model not found, unsound or not for cbst
+        if model is None:
+            raise
+        fail(f"--model {model}: {error}")
     except KeyboardInterrupt:
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
     document = plan_document(
@@ -156,7 +167,7 @@ def plan(
         semantics=result.semantics,
         seed=seed,
         search=result.stats,
-        extra={"particles": result.particles},
+        extra={"particles": result.particles, **({"model": model} if model else {})},
     )
     if output:
         write_json_atomic(Path(output), document)
