@@ -21,7 +21,7 @@ from typing import Any
 
 import arrange_up
 from arrange_up.evaluation.evaluate import evaluate_plan
-from arrange_up.repair.fixture_repair import repair_plan
+from arrange_up.repair import repair_plan
 
 GOLDEN_DIR = Path(__file__).parent / "goldens"
 

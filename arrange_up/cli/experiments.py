@@ -61,7 +61,7 @@ from arrange_up.experiments.planning import (
     transition_markdown,
 )
 from arrange_up.parallel import BackendUnavailableError
-from arrange_up.repair.fixture_repair import METHODS
+from arrange_up.repair import METHODS
 from arrange_up.transitions import available
 
 #: The semantics whose planners --particles makes; --semantics names the others.

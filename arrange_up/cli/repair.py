@@ -24,7 +24,7 @@ from arrange_up.cli.shared import (
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.parallel import available_cores
-from arrange_up.repair.fixture_repair import (
+from arrange_up.repair import (
     DEFAULT_PARTICLES,
     METHODS,
     RepairResult,

@@ -25,7 +25,7 @@ from arrange_up.figures.backend import FIGURE_SUFFIXES
 from arrange_up.figures.render import draw_problem, write_heatmap
 from arrange_up.figures.storyboard import draw_storyboard
 from arrange_up.parallel import available_cores
-from arrange_up.repair.fixture_repair import step_scores
+from arrange_up.repair import step_scores
 from arrange_up.repair.records import REPAIR_SEMANTICS
 from arrange_up.transitions import available
 

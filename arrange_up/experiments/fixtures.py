@@ -1,11 +1,11 @@
 """The thesis's chapter-4 experiment (Figures 4-14 to 4-25): fixture repair, swept over particles.
 
 :func:`fixture_experiment` measures, for each rearrangement problem, how much
-:func:`arrange_up.repair.fixture_repair.repair_plan` improves the reliability of nominal
+:func:`arrange_up.repair.repair_plan` improves the reliability of nominal
 (deterministic) plans and what it costs, as a function of the particles of the belief it scores
 candidates on:
 
-1. ``K`` distinct nominal plans from :func:`arrange_up.repair.fixture_repair.nominal_plans`
+1. ``K`` distinct nominal plans from :func:`arrange_up.repair.nominal_plans`
    (seed ``seed``; the thesis used 20 per problem);
 2. each nominal plan is evaluated by :func:`arrange_up.evaluation.evaluate.evaluate_plan` over
    ``rollouts`` noisy rollouts (one CSV row, stage ``nominal``);
@@ -149,7 +149,7 @@ def fixture_experiment(
     Rows go to ``output_dir/fixtures.csv`` (columns :data:`FIXTURE_FIELDS`), then the PNGs
     are drawn next to it. ``plans`` is ``K``; ``rollouts`` 0 skips every evaluation (the
     evaluation columns stay empty). ``method`` and ``timeout`` (seconds per repair; the thesis
-    allowed 24 hours) go to :func:`~arrange_up.repair.fixture_repair.repair_plan`, ``workers`` to
+    allowed 24 hours) go to :func:`~arrange_up.repair.repair_plan`, ``workers`` to
     it and to
     :func:`~arrange_up.evaluation.evaluate.evaluate_plan` (default: every core), ``backend`` and
     ``scheduler`` to the evaluation only. ``max_tries`` is passed to ``nominal_plans``

@@ -663,8 +663,8 @@ def draw_heatmap(
 ) -> list[Any]:
     """Draw the candidate placements of one push coloured by score (thesis Figure 4-11).
 
-    ``scores`` is a :class:`arrange_up.repair.fixture_repair.StepScores`
-    (:func:`arrange_up.repair.fixture_repair.step_scores`
+    ``scores`` is a :class:`arrange_up.repair.StepScores`
+    (:func:`arrange_up.repair.step_scores`
     computes it). Drawn: the table; the nominal state before the push (parts filled, faded) and
     after it (dashed outlines); with ``particles`` every particle's parts as faint outlines;
     the part motion swaths (dotted boxes); the paddle at its approach pose with an arrow over

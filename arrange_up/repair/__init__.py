@@ -10,8 +10,7 @@ One module per concern:
 * :mod:`~arrange_up.repair.records`: what a repair reports and the plan file it writes
   (:class:`RepairResult`, :class:`StepRecord`, :class:`RepairStats`, :func:`plan_groups`).
 
-Every public name is importable from here (and from :mod:`arrange_up.repair.fixture_repair`,
-the former module).
+Every public name is importable from here.
 """
 
 from arrange_up.repair.candidates import (

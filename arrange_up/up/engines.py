@@ -123,7 +123,7 @@ from arrange_up.evaluation.evaluate import GOAL_MISSED, EvaluationProgress, eval
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Place, Push
 from arrange_up.planning import planner
-from arrange_up.repair.fixture_repair import TIMEOUT, repair_plan
+from arrange_up.repair import TIMEOUT, repair_plan
 from arrange_up.transitions import available
 from arrange_up.transitions.particles import DeterministicSemantics
 from arrange_up.up.compile import (
@@ -766,7 +766,7 @@ def _check_validator_params(
 # ---------------------------------------------------------------------------------------------
 class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
     """Fixture-placement plan repair (thesis ch. 4,
-    :func:`arrange_up.repair.fixture_repair.repair_plan`):
+    :func:`arrange_up.repair.repair_plan`):
     ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
 
     Parameters: ``particles`` (150), ``seed`` (0), ``method`` (``"enhanced"`` or

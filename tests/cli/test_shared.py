@@ -15,7 +15,7 @@ from arrange_up.cli import main, shared
 from arrange_up.parallel import BACKENDS
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import DEFAULT_WEIGHT
-from arrange_up.repair.fixture_repair import DEFAULT_PARTICLES, METHODS
+from arrange_up.repair import DEFAULT_PARTICLES, METHODS
 from arrange_up.transitions import available
 
 

@@ -395,10 +395,3 @@ def test_statuses_are_string_enums_and_statistics_a_dataclass(down_push, down_re
 def down_repair_scores(problem):
     nominal = rp.nominal_plans(problem, 1, seed=0)[0]
     return rp.step_scores(problem, nominal, 1, particles=4, seed=3).placements
-
-
-def test_the_former_module_path_still_works():
-    from arrange_up.repair import fixture_repair
-
-    for name in rp.__all__:
-        assert getattr(fixture_repair, name) is getattr(rp, name)

@@ -23,7 +23,7 @@ import arrange_up.up.engines as engines
 from arrange_up.io.domains import domains_dir, load
 from arrange_up.io.pddl import domain_path
 from arrange_up.planning.planner import plan
-from arrange_up.repair import fixture_repair
+from arrange_up.repair import repair_plan
 from arrange_up.up.compile import plan_from_up, plan_to_up, to_up
 
 engines.register()
@@ -93,7 +93,7 @@ def test_an_inapplicable_plan_is_an_honest_failure(blocks1):
 
 def test_a_repair_that_misses_the_goal_nominally_is_not_returned(blocks1, monkeypatch):
     problem, up_problem, nominal = blocks1
-    real = fixture_repair.repair_plan
+    real = repair_plan
 
     def short_of_the_goal(*args, **kwargs):  # a repair whose plan lost its last push
         outcome = real(*args, **kwargs)
