@@ -95,6 +95,7 @@ from typing import Any
 
 import numpy as np
 
+from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief, ObjectInterval, ParticleBelief
 from arrange_up.geometry import shapes as geometry
 from arrange_up.model.problem import ArrangementProblem, Pose
@@ -169,6 +170,9 @@ def repair_plan(
     timeout
         Wall-clock seconds; checked between batches of candidates (status ``"timeout"``).
 
+    A repaired plan must reach the goal in the deterministic semantics: one that does not (an
+    empty nominal plan, or one short of the goal that no fixture saves) ends with status
+    ``"failed"`` and a ``reason`` naming the parts that miss it.
     Raises ``ValueError`` for bad arguments, or a nominal plan that fails in the deterministic
     semantics (it is not a nominal plan of ``problem``).
     """
@@ -239,11 +243,26 @@ def repair_plan(
                         "choice": record.describe_choice(problem),
                     }
                 )
+        missed = nominal_goal_miss(problem, repairer.nominal_states(out)[-1])
+        if missed:
+            reason = f"the repaired plan does not reach the goal nominally: {missed}"
+            return result(FAILED, None, reason, beliefs)
         return result(SOLVED, tuple(out), beliefs=beliefs)
     except _OutOfTime:
         return result(TIMEOUT, None, f"timeout of {timeout} s reached")
     finally:
         repairer.close()
+
+
+def nominal_goal_miss(problem: ArrangementProblem, state: WorldState) -> str:
+    """Which parts ``state`` leaves outside the goal, as a phrase (empty when none)."""
+    misses = GoalTest(problem).misses(state)
+    return ", ".join(
+        f"{m.part} is not on the table"
+        if m.missing
+        else f"{m.part} misses its goal in " + "/".join(m.dimensions())
+        for m in misses
+    )
 
 
 def step_scores(

@@ -134,16 +134,26 @@ def test_place_and_pick_actions_stay_as_they_are():
     assert all(not isinstance(a, Pick) for a in result.actions)
 
 
-def test_a_push_off_the_table_is_caught_by_a_clamped_fixture(down_push):
+def test_a_push_off_the_table_is_caught_by_a_fixture_but_a_plan_short_of_the_goal_fails(
+    down_push,
+):
     # nominally the block's centre stops 0.2 in from the open edge: with +-0.2 in of push
     # noise and +-15 deg of rotation some particles leave the table unless something stops
-    # them; a fixture (clamped to the table) placed at the edge does
+    # them; a fixture (clamped to the table) placed at the edge does. But the plan never
+    # reaches the goal, so neither does its repair: the repair says so instead of "solved".
     nominal = (Push("paddle", (6.0, 6.816804, -math.pi), 6.0418),)
     assert _reaches_goal(down_push, nominal) is False  # valid, but misses the goal
     result = rp.repair_plan(down_push, nominal, particles=8, seed=0)
-    assert result.status == rp.SOLVED
-    kinds = [type(a) for a in result.actions]
-    assert kinds == [Place, Push, Pick] and result.actions[0].obj == "bar"
+    assert result.status == rp.FAILED and result.actions is None
+    assert "does not reach the goal nominally: block misses its goal in y" in result.reason
+    kinds = [type(a) for a in result.partial]
+    assert kinds == [Place, Push, Pick] and result.partial[0].obj == "bar"
+
+
+def test_a_repair_of_an_empty_plan_says_it_misses_the_goal(down_push):
+    result = rp.repair_plan(down_push, (), particles=2, seed=0)
+    assert result.status == rp.FAILED
+    assert result.reason.endswith("block misses its goal in y")  # it starts on the table
 
 
 def test_a_push_off_the_table_fails_honestly_without_fixtures(down_push):
