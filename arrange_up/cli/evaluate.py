@@ -25,6 +25,7 @@ from arrange_up.cli.shared import (
     terminal_progress,
 )
 from arrange_up.evaluation.evaluate import (
+    LANDINGS,
     EvaluationProgress,
     FailureBreakdown,
     RecordFileError,
@@ -113,6 +114,14 @@ def _failure_lines(
     "file resumes the evaluation.",
 )
 @click.option(
+    "--landing",
+    type=click.Choice(LANDINGS),
+    default="fail",
+    show_default=True,
+    help="A push whose paddle is put down onto a part: fail the action, or shove (let the "
+    "physics resolve the overlap and go on).",
+)
+@click.option(
     "--json",
     "as_json",
     is_flag=True,
@@ -127,6 +136,7 @@ def evaluate(
     backend: str | None,
     scheduler: str | None,
     record: str | None,
+    landing: str,
     as_json: bool,
 ) -> None:
     """Estimate how reliably PLAN.json achieves PROBLEM's goal, by noisy rollouts.
@@ -140,6 +150,7 @@ def evaluate(
     Examples:
       arrange-up evaluate blocks-4 blocks-4.plan.json --rollouts 1000
       arrange-up evaluate blocks-4 b4.json --record b4.rollouts.jsonl --json
+      arrange-up evaluate blocks-4 b4.json --landing shove
       arrange-up evaluate blocks-4 b4.json --backend dask --scheduler tcp://10.0.0.5:8786
 
     Exit status: 0 the evaluation ran (whatever the rate), 1 interrupted, 2 bad input.
@@ -175,6 +186,7 @@ def evaluate(
                 scheduler=scheduler,
                 record=record,
                 progress=update,
+                landing=landing,
             )
     except KeyboardInterrupt:
         kept = f"; the finished rollouts are in {record}: run again to resume" if record else ""
@@ -203,7 +215,8 @@ def evaluate(
         f"{loaded.name}: {result.successes} of {result.trials} rollouts reached the goal: "
         f"{100.0 * result.rate:.1f}% (95% Wilson interval {100.0 * low:.1f}%-{100.0 * high:.1f}%)"
     )
-    click.echo(f"seed {seed}, {where}, {result.elapsed:.1f} s{resumed}")
+    shoved = ", landing: shove" if landing == "shove" else ""
+    click.echo(f"seed {seed}, {where}, {result.elapsed:.1f} s{resumed}{shoved}")
     if result.failures.total:
         click.echo(f"failures: {result.failures.total}")
         for line in _failure_lines(loaded, actions, result.failures):
