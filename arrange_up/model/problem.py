@@ -39,6 +39,8 @@ Point = tuple[float, float]
 ConvexPolygon = tuple[Point, ...]
 
 WALL_EDGES: tuple[str, ...] = ("left", "right", "bottom", "top")
+STANDARD_GRAVITY = 386.09
+"""Standard gravity in in/s^2: the table friction's normal force per unit mass."""
 
 
 class ObjectKind(enum.StrEnum):

@@ -1,0 +1,95 @@
+"""Planning under the compliant controller: do nominal plans exist for the shipped problems?
+
+Usage::
+
+    python benchmarks/controller_plans.py [--problems all] [--controllers servo,compliant]
+        [--particles 0,25,50] [--particle-problems blocks-4] [--timeout 600]
+        [--output controller-plans.csv]
+
+For each shipped problem (``--problems``, comma-separated, default every one) and controller,
+plans with the deterministic planner (one particle, seed 0) and prints a row: status, nodes
+expanded, transitions simulated, plan length, seconds. ``--particles`` adds particle-belief
+runs (seed 0) of ``--particle-problems``. CBST is trained on the servo and is not run here.
+Every row is appended to the CSV as soon as it is measured.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from arrange_up.io.domains import domain_names, load
+from arrange_up.model.problem import Controller, ControllerKind
+from arrange_up.planning.planner import plan
+
+FIELDS = [
+    "problem",
+    "controller",
+    "semantics",
+    "particles",
+    "status",
+    "expanded",
+    "transitions_simulated",
+    "plan_length",
+    "seconds",
+]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--problems", default="all")
+    parser.add_argument("--controllers", default="servo,compliant")
+    parser.add_argument("--particles", default="0", help="0 is the deterministic planner")
+    parser.add_argument("--particle-problems", default="blocks-4")
+    parser.add_argument("--timeout", type=float, default=600.0, help="seconds per plan")
+    parser.add_argument("--output", type=Path, default=None)
+    args = parser.parse_args()
+    names = domain_names() if args.problems == "all" else args.problems.split(",")
+    runs = []
+    for count in (int(v) for v in args.particles.split(",")):
+        chosen = names if count == 0 else args.particle_problems.split(",")
+        runs += [(name, count) for name in chosen]
+    writer = None
+    handle = None
+    if args.output is not None:
+        handle = args.output.open("w", newline="")
+        writer = csv.DictWriter(handle, fieldnames=FIELDS)
+        writer.writeheader()
+    try:
+        for name, count in runs:
+            for kind in args.controllers.split(","):
+                problem = replace(load(name), controller=Controller(kind=ControllerKind(kind)))
+                semantics = "deterministic" if count == 0 else "particles"
+                start = time.perf_counter()
+                result = plan(
+                    problem,
+                    semantics=semantics,
+                    particles=max(count, 1),
+                    seed=0,
+                    timeout=args.timeout,
+                )
+                row = {
+                    "problem": name,
+                    "controller": kind,
+                    "semantics": semantics,
+                    "particles": max(count, 1),
+                    "status": str(result.status.value),
+                    "expanded": result.stats.get("expanded"),
+                    "transitions_simulated": result.stats.get("transitions_simulated"),
+                    "plan_length": len(result.actions or ()),
+                    "seconds": round(time.perf_counter() - start, 2),
+                }
+                print(" ".join(f"{k}={v}" for k, v in row.items()), flush=True)
+                if writer is not None:
+                    writer.writerow(row)
+                    handle.flush()
+    finally:
+        if handle is not None:
+            handle.close()
+
+
+if __name__ == "__main__":
+    main()
