@@ -128,3 +128,14 @@ def test_default_angle_gain_matches_the_translation_frequency():
     assert kd == pytest.approx(math.sqrt(4 * 0.15 * kp))
     assert (force, speed) == (400.0, DEFAULT_SETTINGS.push_speed)
     assert torque == pytest.approx(400.0 * math.sqrt(0.08 / 0.15))
+
+
+def test_plan_files_record_a_controller_that_is_not_the_default():
+    from arrange_up.io.planfile import plan_document
+
+    servo = load_problem_text(_FILE)
+    compliant = load_problem_text(_FILE + "controller: {kind: compliant, speed: 2.54}\n")
+    kw = {"status": "solved", "semantics": "deterministic", "seed": 0, "search": {}}
+    assert "controller" not in plan_document(servo, (), **kw)
+    recorded = plan_document(compliant, (), **kw)["controller"]
+    assert recorded == {"kind": "compliant", "kp": 300.0, "speed": 2.54}  # in the file's cm
