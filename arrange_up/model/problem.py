@@ -207,10 +207,11 @@ class Controller:
 
     ``None`` means the documented default (see :mod:`arrange_up.physics.simulation`):
     ``speed`` the physics settings' push speed (3 in/s), ``force`` the problem's force clip
-    (:func:`arrange_up.physics.settings.push_force`), ``kp_angle`` ``kp * I / m`` of the paddle
-    (the same natural frequency in rotation as in translation) and ``torque`` ``force *
-    sqrt(I / m)`` (the clip applied at the paddle's radius of gyration). ``kp``, ``kp_angle``
-    and ``torque`` are used by ``compliant`` only.
+    (:func:`arrange_up.physics.settings.push_force`), ``kp_angle`` ``kp * r^2`` with ``r`` the
+    paddle's radius (the largest distance of its outline from its centroid: a force at its end
+    moves the end about as far by turning the paddle as a force at its centre moves the
+    centre) and ``torque`` ``force * r`` (the force clip at the paddle's end). ``kp``,
+    ``kp_angle`` and ``torque`` are used by ``compliant`` only.
     """
 
     kind: ControllerKind = ControllerKind.SERVO

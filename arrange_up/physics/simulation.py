@@ -523,6 +523,7 @@ def _push(
                 paddle,
                 paddle_mass,
                 paddle_moment,
+                paddle_def.radius,
                 force,
                 (px, py, pth),
                 (dx, dy),
@@ -666,12 +667,13 @@ class _Tracking:
         paddle,
         mass: float,
         moment: float,
+        radius: float,
         default_force: float,
         start: Pose,
         direction: tuple[float, float],
         step=lib.cpSpaceStep,
     ) -> None:
-        gains = compliant_gains(controller, settings, mass, moment, default_force)
+        gains = compliant_gains(controller, settings, mass, moment, radius, default_force)
         self.kp, self.kd, self.kp_a, self.kd_a, self.force, self.torque, self.speed = gains
         self.space_dt = settings.dt
         self.paddle = paddle
@@ -736,17 +738,20 @@ def compliant_gains(
     settings: PhysicsSettings,
     mass: float,
     moment: float,
+    radius: float,
     default_force: float,
 ) -> tuple[float, float, float, float, float, float, float]:
     """``(Kp, Kd, Kp_angle, Kd_angle, force clip, torque clip, speed)`` of the compliant
-    controller for a paddle of ``mass`` and ``moment``, the ``None`` fields of ``controller``
-    at their defaults (:class:`~arrange_up.model.problem.Controller`);
+    controller for a paddle of ``mass``, ``moment`` and ``radius`` (the largest distance of
+    its outline from its centroid), the ``None`` fields of ``controller`` at their defaults
+    (:class:`~arrange_up.model.problem.Controller`): ``Kp_angle = Kp radius^2``, so that a
+    force at the paddle's end moves that end about as far by turning it as a force at its
+    centre moves the centre (a wrist as stiff as the arm), and ``torque = force * radius``;
     ``Kd = damping_ratio * sqrt(4 m Kp)`` and likewise on the angle."""
-    gyration2 = moment / mass
     kp = controller.kp
-    kp_a = kp * gyration2 if controller.kp_angle is None else controller.kp_angle
+    kp_a = kp * radius * radius if controller.kp_angle is None else controller.kp_angle
     force = default_force if controller.force is None else controller.force
-    torque = force * math.sqrt(gyration2) if controller.torque is None else controller.torque
+    torque = force * radius if controller.torque is None else controller.torque
     speed = settings.push_speed if controller.speed is None else controller.speed
     zeta = settings.damping_ratio
     kd = zeta * math.sqrt(4.0 * mass * kp)

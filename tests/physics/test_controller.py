@@ -118,16 +118,19 @@ def test_controller_mapping_errors(mapping, message):
     assert "controller" in str(error.value)
 
 
-def test_default_angle_gain_matches_the_translation_frequency():
+def test_default_angle_gain_makes_the_wrist_as_stiff_as_the_arm():
     from arrange_up.physics.simulation import DEFAULT_SETTINGS, compliant_gains
 
     kp, kd, kp_a, kd_a, force, torque, speed = compliant_gains(
-        COMPLIANT, DEFAULT_SETTINGS, 0.15, 0.08, 400.0
+        COMPLIANT, DEFAULT_SETTINGS, 0.15, 0.08, 1.25, 400.0
     )
-    assert math.sqrt(kp / 0.15) == pytest.approx(math.sqrt(kp_a / 0.08))
+    # a force F at the paddle's end (1.25 in out) turns it by F r / Kp_angle, moving the end
+    # F r^2 / Kp_angle: as far as F moves the centre, F / Kp
+    assert 1.25 * 1.25 / kp_a == pytest.approx(1.0 / kp)
     assert kd == pytest.approx(math.sqrt(4 * 0.15 * kp))
+    assert kd_a == pytest.approx(math.sqrt(4 * 0.08 * kp_a))
     assert (force, speed) == (400.0, DEFAULT_SETTINGS.push_speed)
-    assert torque == pytest.approx(400.0 * math.sqrt(0.08 / 0.15))
+    assert torque == pytest.approx(400.0 * 1.25)
 
 
 def test_plan_files_record_a_controller_that_is_not_the_default():
