@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/controller_plans.py [--problems all] [--controllers servo,compliant]
-        [--particles 0,25,50] [--particle-problems blocks-4] [--timeout 600]
+        [--kp 300] [--particles 0,25,50] [--particle-problems blocks-4] [--timeout 600]
         [--output controller-plans.csv]
 
 For each shipped problem (``--problems``, comma-separated, default every one) and controller,
@@ -42,6 +42,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problems", default="all")
     parser.add_argument("--controllers", default="servo,compliant")
+    parser.add_argument("--kp", type=float, default=None, help="the compliant controller's gain")
     parser.add_argument("--particles", default="0", help="0 is the deterministic planner")
     parser.add_argument("--particle-problems", default="blocks-4")
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds per plan")
@@ -61,7 +62,10 @@ def main() -> None:
     try:
         for name, count in runs:
             for kind in args.controllers.split(","):
-                problem = replace(load(name), controller=Controller(kind=ControllerKind(kind)))
+                controller = Controller(kind=ControllerKind(kind))
+                if args.kp is not None and controller.kind is ControllerKind.COMPLIANT:
+                    controller = replace(controller, kp=args.kp)
+                problem = replace(load(name), controller=controller)
                 semantics = "deterministic" if count == 0 else "particles"
                 start = time.perf_counter()
                 result = plan(
@@ -73,7 +77,9 @@ def main() -> None:
                 )
                 row = {
                     "problem": name,
-                    "controller": kind,
+                    "controller": kind
+                    if controller.kind is ControllerKind.SERVO
+                    else f"{kind} kp={controller.kp:g}",
                     "semantics": semantics,
                     "particles": max(count, 1),
                     "status": str(result.status.value),
