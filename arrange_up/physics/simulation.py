@@ -118,7 +118,7 @@ force and torque
 where the set point ``x_ref(t)`` moves from the approach pose along the push line at ``speed``
 and stops ``distance`` along it: the thesis's real robot fed its low-gain controller
 intermediate set points along the pushing line, updated with time (§2.4.2). A PD toward the
-distant end point with no speed limit would be a catapult (the paddle reaches 30-80 in/s and
+distant end point with no speed limit would be a catapult (the paddle reached 65-110 in/s and
 throws blocks; see ``docs/design/physics.md``). The paddle has its own moment here (a compliant
 wrist turns when a part meets it off-centre) and still no table friction. The drive runs until
 the set point has stopped and the paddle has been still (position and angle) for
