@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/controller_plans.py [--problems all] [--controllers servo,compliant]
         [--kp 300] [--particles 0,25,50] [--particle-problems blocks-4] [--timeout 600]
+        [--max-nodes N]
         [--output controller-plans.csv]
 
 For each shipped problem (``--problems``, comma-separated, default every one) and controller,
@@ -46,6 +47,9 @@ def main() -> None:
     parser.add_argument("--particles", default="0", help="0 is the deterministic planner")
     parser.add_argument("--particle-problems", default="blocks-4")
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds per plan")
+    parser.add_argument(
+        "--max-nodes", type=int, default=None, help="node limit (default: each problem's own)"
+    )
     parser.add_argument("--output", type=Path, default=None)
     args = parser.parse_args()
     names = domain_names() if args.problems == "all" else args.problems.split(",")
@@ -74,6 +78,7 @@ def main() -> None:
                     particles=max(count, 1),
                     seed=0,
                     timeout=args.timeout,
+                    max_nodes=args.max_nodes,
                 )
                 row = {
                     "problem": name,
