@@ -5,6 +5,7 @@ Usage::
     python benchmarks/controller_plans.py [--problems all] [--controllers servo,compliant]
         [--kp 300] [--particles 0,25,50] [--particle-problems blocks-4] [--timeout 600]
         [--max-nodes N]
+    python benchmarks/controller_plans.py --follow-servo --problems blocks-9-square
         [--output controller-plans.csv]
 
 For each shipped problem (``--problems``, comma-separated, default every one) and controller,
@@ -24,7 +25,9 @@ from pathlib import Path
 
 from arrange_up.io.domains import domain_names, load
 from arrange_up.model.problem import Controller, ControllerKind
+from arrange_up.model.world import Push
 from arrange_up.planning.planner import plan
+from arrange_up.planning.task import BeliefTask
 
 FIELDS = [
     "problem",
@@ -39,6 +42,54 @@ FIELDS = [
 ]
 
 
+def follow_servo(name: str, kp: float | None) -> None:
+    """Whether the compliant search space holds the servo's plan: from the compliant planner's
+    initial belief, take at each step the candidate the compliant generator offers that is the
+    servo plan's action (a place) or its push from within 0.1 in of the same approach pose and
+    angle with the nearest distance, and print each step's heuristic and whether the goal is
+    reached."""
+    servo = load(name)
+    servo_plan = plan(servo, semantics="deterministic").actions
+    controller = Controller(kind=ControllerKind.COMPLIANT)
+    if kp is not None:
+        controller = replace(controller, kp=kp)
+    task = BeliefTask.build(
+        replace(servo, controller=controller),
+        semantics="deterministic",
+        particles=1,
+        seed=0,
+        workers=1,
+        heuristic="inadmissible",
+        dominance=True,
+        variety=False,
+    )
+    belief = task.initial_belief()
+    try:
+        for k, action in enumerate(servo_plan):
+            edges = list(task.successors(belief))
+            if isinstance(action, Push):
+                same = [
+                    e
+                    for e in edges
+                    if isinstance(e.action, Push)
+                    and abs(e.action.pose[2] - action.pose[2]) < 1e-9
+                    and max(abs(e.action.pose[i] - action.pose[i]) for i in (0, 1)) < 0.1
+                ]
+                same.sort(key=lambda e: abs(e.action.distance - action.distance))
+            else:
+                same = [e for e in edges if e.action == action]
+            child = same[0].make_child() if same else None
+            if child is None:
+                print(f"{name}: step {k}: the compliant generator offers no {action}")
+                return
+            h = task.heuristic(child)
+            print(f"{name}: step {k}: {same[0].action} (servo: {action}); h {h:.3g}")
+            belief = child
+        print(f"{name}: the followed plan reaches the goal: {task.is_goal(belief)}")
+    finally:
+        task.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problems", default="all")
@@ -51,8 +102,18 @@ def main() -> None:
         "--max-nodes", type=int, default=None, help="node limit (default: each problem's own)"
     )
     parser.add_argument("--output", type=Path, default=None)
+    parser.add_argument(
+        "--follow-servo",
+        action="store_true",
+        help="instead, follow each problem's servo plan with the compliant generator's nearest "
+        "candidates (does the compliant search space hold it?)",
+    )
     args = parser.parse_args()
     names = domain_names() if args.problems == "all" else args.problems.split(",")
+    if args.follow_servo:
+        for name in names:
+            follow_servo(name, args.kp)
+        return
     runs = []
     for count in (int(v) for v in args.particles.split(",")):
         chosen = names if count == 0 else args.particle_problems.split(",")

@@ -433,7 +433,7 @@ class ActionGenerator:
             if abs(error) <= SOLVER_TOLERANCE or distance + error <= MIN_PUSH:
                 break
             distance += error
-            push = Push(push.manipulator, push.pose, round(distance, 4))
+            push = Push(push.manipulator, push.pose, round(float(distance), 4))
         return push.distance
 
     def _stall(self, name: str, belief: IntervalBelief, axis: int, sign: int) -> float:
