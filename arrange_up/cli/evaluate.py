@@ -28,6 +28,7 @@ from arrange_up.cli.shared import (
     terminal_progress,
 )
 from arrange_up.evaluation.evaluate import (
+    LANDINGS,
     EvaluationProgress,
     FailureBreakdown,
     RecordFileError,
@@ -109,6 +110,14 @@ def _failure_lines(
     help="Append every rollout to this .jsonl file as it finishes; re-running with the same "
     "file resumes the evaluation.",
 )
+@click.option(
+    "--landing",
+    type=click.Choice(LANDINGS),
+    default="fail",
+    show_default=True,
+    help="A push whose paddle is put down onto a part: fail the action, or shove (let the "
+    "physics resolve the overlap and go on).",
+)
 @json_option("Print a machine-readable summary (JSON) on stdout.")
 def evaluate(
     problem: str,
@@ -119,6 +128,7 @@ def evaluate(
     backend: str | None,
     scheduler: str | None,
     record: str | None,
+    landing: str,
     as_json: bool,
 ) -> None:
     """Estimate how reliably PLAN.json achieves PROBLEM's goal, by noisy rollouts.
@@ -132,6 +142,7 @@ def evaluate(
     Examples:
       arrange-up evaluate blocks-4 blocks-4.plan.json --rollouts 1000
       arrange-up evaluate blocks-4 b4.json --record b4.rollouts.jsonl --json
+      arrange-up evaluate blocks-4 b4.json --landing shove
       arrange-up evaluate blocks-4 b4.json --backend dask --scheduler tcp://10.0.0.5:8786
 
     Exit status: 0 the evaluation ran (whatever the rate), 1 interrupted, 2 bad input.
@@ -167,6 +178,7 @@ def evaluate(
                 scheduler=scheduler,
                 record=record,
                 progress=update,
+                landing=landing,
             )
     except KeyboardInterrupt:
         kept = f"; the finished rollouts are in {record}: run again to resume" if record else ""
@@ -195,7 +207,8 @@ def evaluate(
         f"{loaded.name}: {result.successes} of {result.trials} rollouts reached the goal: "
         f"{100.0 * result.rate:.1f}% (95% Wilson interval {100.0 * low:.1f}%-{100.0 * high:.1f}%)"
     )
-    click.echo(f"seed {seed}, {where}, {result.elapsed:.1f} s{resumed}")
+    shoved = ", landing: shove" if landing == "shove" else ""
+    click.echo(f"seed {seed}, {where}, {result.elapsed:.1f} s{resumed}{shoved}")
     if result.failures.total:
         click.echo(f"failures: {result.failures.total}")
         for line in _failure_lines(loaded, actions, result.failures):

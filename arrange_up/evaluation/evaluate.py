@@ -65,10 +65,12 @@ from arrange_up.evaluation.reliability import (
     wilson_interval,
 )
 from arrange_up.evaluation.rollouts import (
+    LANDINGS,
     PUSH_OVERLAP_REASON,
     Execution,
     RolloutContext,
     Rollouts,
+    check_landing,
     execute_plan,
     rollout_task,
     simulate_rollout,
@@ -83,6 +85,7 @@ __all__ = [
     "ACTION_FAILED",
     "FAILURE_KINDS",
     "GOAL_MISSED",
+    "LANDINGS",
     "NOT_AT_REST",
     "OFF_TABLE",
     "PUSH_OVERLAP_REASON",
@@ -132,6 +135,7 @@ def evaluate_plan(
     progress: ProgressCallback | None = None,
     chunksize: int | None = None,
     keep_records: bool = False,
+    landing: str = "fail",
 ) -> Reliability:
     """Estimate how often ``actions`` achieve ``problem``'s goal under its full noise.
 
@@ -158,6 +162,11 @@ def evaluate_plan(
         tasks per worker, at most 25 rollouts each).
     keep_records
         Keep every rollout's record in :attr:`Reliability.records`.
+    landing
+        ``"fail"`` (a push whose paddle is put down onto a part fails the action) or
+        ``"shove"`` (the physics resolves the overlap); see
+        :mod:`arrange_up.evaluation.rollouts`. Recorded in the record file's header and in the
+        result.
 
     Raises
     ------
@@ -179,6 +188,7 @@ def evaluate_plan(
         not isinstance(chunksize, int) or isinstance(chunksize, bool) or chunksize < 1
     ):
         raise ValueError(f"chunksize must be a positive integer, got {chunksize!r}")
+    check_landing(landing)
     actions = tuple(actions)
     for action in actions:
         if not isinstance(action, Place | Push | Pick):
@@ -189,7 +199,10 @@ def evaluate_plan(
     file = None
     records: dict[int, RolloutRecord] = {}
     if record is not None:
-        header = record_header(problem, phash, lhash, len(actions), seed, DEFAULT_SETTINGS)
+        # The landing rule changes outcomes: a shoving evaluation hashes its settings with it
+        # (a failing one as before, so existing record files resume).
+        physics = DEFAULT_SETTINGS if landing == "fail" else (DEFAULT_SETTINGS, landing)
+        header = record_header(problem, phash, lhash, len(actions), seed, physics)
         file = RecordFile(Path(record), header)
         records = {i: r for i, r in file.records.items() if i < rollouts}
     resumed = len(records)
@@ -203,7 +216,7 @@ def evaluate_plan(
             runner = get_runner(backend, workers, scheduler)
             runner_workers = runner.workers
             size = chunksize or auto_chunksize(len(todo), runner.workers)
-            context = RolloutContext(f"{phash} {lhash}", problem, actions, seed)
+            context = RolloutContext(f"{phash} {lhash} {landing}", problem, actions, seed, landing)
             for index, result in runner.map(partial(rollout_task, context), todo, size):
                 records[index] = result
                 successes += result.success
@@ -234,6 +247,7 @@ def evaluate_plan(
         backend=runner_backend,
         workers=runner_workers,
         records=tuple(ordered) if keep_records else None,
+        landing=landing,
     )
 
 

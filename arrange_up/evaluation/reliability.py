@@ -189,6 +189,8 @@ class Reliability:
     ``backend`` and ``workers`` describe the run, not the result: they are left out of ``==``,
     so a resumed evaluation compares equal to an uninterrupted one. ``records`` holds every
     rollout's :class:`RolloutRecord` in index order when asked for (``keep_records=True``).
+    ``landing`` is the evaluation's landing rule (``fail`` or ``shove``,
+    :mod:`arrange_up.evaluation.rollouts`); the JSON names it when it is not ``fail``.
     """
 
     successes: int
@@ -202,13 +204,14 @@ class Reliability:
     backend: str = field(default="local", compare=False)
     workers: int = field(default=1, compare=False)
     records: tuple[RolloutRecord, ...] | None = None
+    landing: str = "fail"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "rate", self.successes / self.trials if self.trials else 0.0)
         object.__setattr__(self, "interval", wilson_interval(self.successes, self.trials))
 
     def to_json(self) -> dict[str, Any]:
-        return {
+        data: dict[str, Any] = {
             "successes": self.successes,
             "trials": self.trials,
             "rate": self.rate,
@@ -220,6 +223,9 @@ class Reliability:
             "backend": self.backend,
             "workers": self.workers,
         }
+        if self.landing != "fail":
+            data["landing"] = self.landing
+        return data
 
 
 @dataclass(frozen=True)

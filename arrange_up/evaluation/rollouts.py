@@ -21,6 +21,9 @@ The rollout fails at the first of these (and records which):
   shapes overlapping by more than the physics' ``overlap_tolerance`` (0.02 in; the paddle was
   put down on a part); or a place puts its object overlapping another object, a wall or an
   obstacle by more than that tolerance (the physics does not check places).
+  With ``landing="shove"`` a push that starts overlapping is not a failure: the physics
+  resolves the overlap (the paddle shoves what it was put down on aside) and the rollout goes
+  on; the default ``landing="fail"`` is the rule above (:data:`LANDINGS`).
 * ``not_at_rest``: a push's simulation hit its time cap before everything came to rest.
 * ``off_table``: an object's centroid ended outside the table (open edges).
 * ``goal_missed``: the plan ran through, but at least one goal part misses its tolerance (the
@@ -30,8 +33,9 @@ The rollout fails at the first of these (and records which):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -53,10 +57,12 @@ from arrange_up.physics import simulation  # simulate looked up per call: tests 
 from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus
 
 __all__ = [
+    "LANDINGS",
     "PUSH_OVERLAP_REASON",
     "Execution",
     "RolloutContext",
     "Rollouts",
+    "check_landing",
     "execute_plan",
     "rollout_task",
     "simulate_rollout",
@@ -64,6 +70,16 @@ __all__ = [
 ]
 
 PUSH_OVERLAP_REASON = "the push started with shapes overlapping"
+#: What a push whose paddle is put down onto a part does: ``fail`` the action (the default) or
+#: ``shove`` (the physics resolves the overlap and the rollout goes on).
+LANDINGS: tuple[str, ...] = ("fail", "shove")
+
+
+def check_landing(landing: str) -> str:
+    """``landing`` if it is one of :data:`LANDINGS`, else ``ValueError``."""
+    if landing not in LANDINGS:
+        raise ValueError(f"unknown landing {landing!r}; expected one of {', '.join(LANDINGS)}")
+    return landing
 
 
 @dataclass(frozen=True)
@@ -94,10 +110,16 @@ class Rollouts:
         problem: ArrangementProblem,
         actions: Sequence[Action],
         settings: PhysicsSettings = DEFAULT_SETTINGS,
+        landing: str = "fail",
     ) -> None:
         self.problem = problem
         self.actions = tuple(actions)
         self.settings = settings
+        self.landing = check_landing(landing)
+        # Shoving: the physics never reports a push's start as OVERLAP (places keep the check).
+        self.push_settings = (
+            settings if landing == "fail" else replace(settings, overlap_tolerance=math.inf)
+        )
         self.goal = GoalTest(problem)
         self.frame = AngleFrame.of(problem)
         self.depths = PenetrationDepths(problem)
@@ -140,7 +162,7 @@ class Rollouts:
         for k, action in enumerate(self.actions):
             noise = draw_noise(problem, action, rng)
             try:
-                outcome = simulation.simulate(problem, state, action, noise, self.settings)
+                outcome = simulation.simulate(problem, state, action, noise, self.push_settings)
             except ValueError as error:
                 return state, Failure(ACTION_FAILED, k, str(error))
             if outcome.status is StepStatus.OVERLAP:
@@ -174,25 +196,34 @@ def execute_plan(
     actions: Sequence[Action],
     rng: np.random.Generator,
     settings: PhysicsSettings = DEFAULT_SETTINGS,
+    landing: str = "fail",
 ) -> Execution:
     """Execute ``actions`` from ``state`` as a rollout does (noise drawn from ``rng`` per
     action, the same failures), without sampling the start or testing the goal."""
-    return Rollouts(problem, actions, settings).execute(state, rng)
+    return Rollouts(problem, actions, settings, landing).execute(state, rng)
 
 
 def simulate_rollout(
-    problem: ArrangementProblem, actions: Sequence[Action], seed: int, index: int
+    problem: ArrangementProblem,
+    actions: Sequence[Action],
+    seed: int,
+    index: int,
+    landing: str = "fail",
 ) -> RolloutRecord:
     """Run rollout ``index`` of an evaluation with ``seed`` (see the module docstring).
 
     The same ``(seed, index)`` always gives the same record; use it to replay one rollout of
     an evaluation (:func:`trace_rollout` gives its states).
     """
-    return Rollouts(problem, actions).run(seed, index)
+    return Rollouts(problem, actions, landing=landing).run(seed, index)
 
 
 def trace_rollout(
-    problem: ArrangementProblem, actions: Sequence[Action], seed: int, index: int
+    problem: ArrangementProblem,
+    actions: Sequence[Action],
+    seed: int,
+    index: int,
+    landing: str = "fail",
 ) -> tuple[WorldState, ...]:
     """The world states of rollout ``index`` (the same rollout
     :func:`~arrange_up.evaluation.evaluate.evaluate_plan` runs with ``seed``): the initial
@@ -200,19 +231,20 @@ def trace_rollout(
     action's state is not included; a rollout that only missed the goal has all
     ``len(actions) + 1`` states)."""
     states: list[WorldState] = []
-    Rollouts(problem, actions).run(seed, index, states)
+    Rollouts(problem, actions, landing=landing).run(seed, index, states)
     return tuple(states)
 
 
 @dataclass(frozen=True)
 class RolloutContext:
     """What a worker needs to run rollouts of one evaluation (pickled with each task); ``key``
-    identifies the evaluation (its problem and plan hashes)."""
+    identifies the evaluation (its problem and plan hashes, and the landing rule)."""
 
     key: str
     problem: ArrangementProblem
     actions: tuple[Action, ...]
     seed: int
+    landing: str = "fail"
 
 
 def rollout_task(context: RolloutContext, index: int) -> RolloutRecord:
@@ -232,5 +264,7 @@ def _cached(context: RolloutContext) -> Rollouts:
     if hit is None:
         if len(_CACHE) >= 8:
             _CACHE.pop(next(iter(_CACHE)))
-        hit = _CACHE[context.key] = Rollouts(context.problem, context.actions)
+        hit = _CACHE[context.key] = Rollouts(
+            context.problem, context.actions, landing=context.landing
+        )
     return hit

@@ -9,6 +9,7 @@ and ``repair``) is a JSON object::
       "units": {"length": "in", "angle": "deg"},
       "status": "solved",
       "semantics": "particles", "particles": 50, "seed": 0,
+      "controller": {"kind": "compliant", "kp": 300},
       "search": {"expanded": 41, "generated": 380, …, "elapsed": 12.3},
       "actions": [
         {"type": "place", "object": "A", "pose": [9.1, 0.9, 0.0]},
@@ -21,7 +22,8 @@ Poses and distances are in the problem's own units (``units``). ``actions`` is p
 the plan complete, only when ``status`` is ``"solved"``; any other status records an honest
 failure with its search statistics. ``hash`` identifies the problem's content (see
 :func:`arrange_up.model.problem.problem_hash`); the commands that read plans warn when it does not
-match the problem they are given (:func:`plan_problem_mismatch`).
+match the problem they are given (:func:`plan_problem_mismatch`). ``controller`` is the problem's
+push controller (:func:`controller_to_json`), present when it is not the default one.
 """
 
 from __future__ import annotations
@@ -36,7 +38,12 @@ from typing import Any
 
 from arrange_up.io.validation import angle_problem
 from arrange_up.io.yaml_source import long_number
-from arrange_up.model.problem import ArrangementProblem, ObjectKind, problem_hash
+from arrange_up.model.problem import (
+    DEFAULT_CONTROLLER,
+    ArrangementProblem,
+    ObjectKind,
+    problem_hash,
+)
 from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
 from arrange_up.model.world import Action, Pick, Place, Push
 
@@ -141,12 +148,34 @@ def plan_document(
         "semantics": semantics,
         "seed": seed,
     }
+    if problem.controller != DEFAULT_CONTROLLER:
+        doc["controller"] = controller_to_json(problem)
     if extra:
         doc.update(extra)
     doc["search"] = dict(search)
     if status == "solved" and actions is not None:
         doc["actions"] = [action_to_json(a, problem.units) for a in actions]
     return doc
+
+
+def controller_to_json(problem: ArrangementProblem) -> dict[str, Any]:
+    """The problem's push controller as its ``controller:`` mapping reads, in the problem's
+    units (omitted keys were left at their defaults)."""
+    controller = problem.controller
+    length = problem.units.length_factor
+    scale = {
+        "kp": 1.0,
+        "kp_angle": length * length / problem.units.angle_factor,
+        "speed": length,
+        "force": length,
+        "torque": length * length,
+    }
+    data: dict[str, Any] = {"kind": controller.kind.value}
+    for key, factor in scale.items():
+        value = getattr(controller, key)
+        if value is not None:
+            data[key] = _round(value / factor)
+    return data
 
 
 def write_json_atomic(path: Path, document: Mapping[str, Any]) -> Path:

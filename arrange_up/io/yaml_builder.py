@@ -18,8 +18,11 @@ from arrange_up.io.shape_forms import box_shape, ccw_polygon, centred_shape, con
 from arrange_up.io.validation import Placed
 from arrange_up.io.yaml_source import Node, NodeReader, at, describe, fmt, is_number, suggest
 from arrange_up.model.problem import (
+    DEFAULT_CONTROLLER,
     WALL_EDGES,
     ArrangementProblem,
+    Controller,
+    ControllerKind,
     ConvexPolygon,
     Goal,
     InitialObject,
@@ -56,11 +59,15 @@ TOP_LEVEL_KEYS = (
     "goal",
     "uncertainty",
     "planning",
+    "controller",
 )
 SHAPE_FORMS = ("box", "polygon", "convex_parts")
 SHAPE_EXPECTED = "{box: [w, h]}, {polygon: [...]}, {convex_parts: [...]}"
 PUSH_DIRECTIONS = ("+x", "-x", "+y", "-y")
 PLANNING_KEYS = ("place_offsets", "place_angles", "push_distances", "push_directions", "max_nodes")
+CONTROLLER_KEYS = ("kind", "kp", "kp_angle", "speed", "force", "torque")
+#: Keys the servo controller reads (the others tune the compliant controller only).
+SERVO_KEYS = ("kind", "speed", "force")
 UNCERTAINTY_KEYS = ("place", "push", "friction", "part_density", "manipulator_density")
 KIND_NAMES = tuple(kind.value for kind in ObjectKind)
 _ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
@@ -101,6 +108,7 @@ class ProblemBuilder(NodeReader):
         goal = self.goal(root, objects)
         uncertainty = self.uncertainty(root)
         planning = self.planning(root)
+        controller = self.controller(root)
 
         if table is not None and goal is not None:
             self.check_goal_on_table(root, table, objects, goal)
@@ -108,7 +116,7 @@ class ProblemBuilder(NodeReader):
         if self.report.error_count:
             return None
         assert name is not None and table is not None and goal is not None
-        assert uncertainty is not None and planning is not None
+        assert uncertainty is not None and planning is not None and controller is not None
         specs = tuple(
             ObjectSpec(o.name, o.kind, o.shape, o.pose)  # type: ignore[arg-type]
             for o in objects.values()
@@ -121,6 +129,7 @@ class ProblemBuilder(NodeReader):
             goal=goal,
             uncertainty=uncertainty,
             planning=planning,
+            controller=controller,
             description=description or "",
             units=self.units,
             source=self.report.source,
@@ -858,6 +867,75 @@ class ProblemBuilder(NodeReader):
                 self.error(child, f"expected a positive whole number, got {describe(value)}")
                 ok = False
         return PlanningHints(**hints) if ok else None
+
+    # -- the push controller --------------------------------------------------------------------
+    def controller(self, root: Node) -> Controller | None:
+        """The ``controller:`` mapping (``docs/problem-format.md``), converted to internal units:
+        ``kp`` in mass/s^2 needs no conversion, ``speed`` is a length per second, ``force`` a
+        mass x length/s^2, ``torque`` a mass x length^2/s^2 and ``kp_angle`` a torque per angle
+        unit."""
+        if not root.has("controller"):
+            return DEFAULT_CONTROLLER
+        node = root.child("controller")
+        if not self.mapping(
+            node, "a mapping {kind: compliant | servo, ...} (" + ", ".join(CONTROLLER_KEYS) + ")"
+        ):
+            return None
+        ok = True
+        for key_node, _ in node.entries():
+            if key_node.value not in CONTROLLER_KEYS:
+                # An error, not a warning: a misspelt gain would silently change the physics.
+                self.error(
+                    key_node,
+                    f"unknown controller key {key_node.value!r}"
+                    f"{suggest(key_node.value, CONTROLLER_KEYS)}; expected one of "
+                    f"{', '.join(CONTROLLER_KEYS)}",
+                )
+                ok = False
+        kinds = tuple(kind.value for kind in ControllerKind)
+        kind: ControllerKind | None = DEFAULT_CONTROLLER.kind
+        if node.has("kind"):
+            kind_node = node.child("kind")
+            if kind_node.value in kinds:
+                kind = ControllerKind(kind_node.value)
+            else:
+                kind = None
+                self.error(
+                    kind_node, f"expected {' or '.join(kinds)}, got {describe(kind_node.value)}"
+                )
+        if kind is ControllerKind.SERVO:
+            for key_node, _ in node.entries():
+                if key_node.value in CONTROLLER_KEYS and key_node.value not in SERVO_KEYS:
+                    self.error(
+                        key_node,
+                        f"{key_node.value!r} tunes the compliant controller only; the servo "
+                        f"reads {', '.join(SERVO_KEYS)}",
+                    )
+                    ok = False
+        length = self.units.length_factor
+        scale = {
+            "kp": 1.0,
+            "kp_angle": length * length / self.units.angle_factor,
+            "speed": length,
+            "force": length,
+            "torque": length * length,
+        }
+        values: dict[str, Any] = {}
+        for key, factor in scale.items():
+            if not node.has(key):
+                continue
+            child = node.child(key)
+            value = self.number(child, f"a positive {key}")
+            if value is None:
+                ok = False
+            elif value <= 0:
+                self.error(child, f"expected a positive {key}, got {fmt(value)}")
+                ok = False
+            else:
+                values[key] = value * factor
+        if kind is None or not ok:
+            return None
+        return Controller(kind=kind, **values)
 
     def push_directions(self, node: Node) -> tuple[str, ...] | None:
         items = self.list_of(node, f"a non-empty list drawn from {', '.join(PUSH_DIRECTIONS)}")

@@ -54,6 +54,9 @@ Semantics beyond the bare format, all enforced here:
   (angles), ``push_distances`` (positive lengths), ``push_directions`` (a subset of +x, -x, +y,
   -y) and ``max_nodes`` (a positive integer); lists must be non-empty. Unknown keys inside
   ``planning`` are errors, since a typo there would silently change planning.
+* **controller**: ``kind`` (``compliant`` or ``servo``; default the problem default) and the
+  positive numbers ``kp``, ``kp_angle``, ``speed``, ``force``, ``torque`` (the servo reads only
+  ``speed`` and ``force``). Unknown keys are errors, as in ``planning``.
 * Unknown keys anywhere else are **warnings** (the format welcomes new optional keys).
 * Every number must be a finite real; booleans are not numbers. Duplicate keys are errors,
   reported at each duplicate. Problems are collected through the whole file, but follow-on

@@ -39,6 +39,8 @@ Point = tuple[float, float]
 ConvexPolygon = tuple[Point, ...]
 
 WALL_EDGES: tuple[str, ...] = ("left", "right", "bottom", "top")
+STANDARD_GRAVITY = 386.09
+"""Standard gravity in in/s^2: the table friction's normal force per unit mass."""
 
 
 class ObjectKind(enum.StrEnum):
@@ -185,6 +187,50 @@ class PlanningHints:
     max_nodes: int | None = None
 
 
+class ControllerKind(enum.StrEnum):
+    """How the robot drives a pushing manipulator (``controller.kind`` in a problem file)."""
+
+    COMPLIANT = "compliant"
+    """The thesis's controller (§2.4.1, §2.4.2): a low-gain clipped PD per axis and on the
+    angle, tracking a set point that moves along the push line at the push speed; a resisted
+    push stops short."""
+    SERVO = "servo"
+    """A stiff, speed-limited position servo (a position-controlled arm): a push ends where it
+    was sent unless the force clip or a wall stops it."""
+
+
+@dataclass(frozen=True)
+class Controller:
+    """The push controller (``controller:`` in a problem file), in internal units: inches,
+    seconds, radians, mass in the problem's mass unit (density x square inch), force in mass x
+    in/s^2.
+
+    ``None`` means the documented default (see :mod:`arrange_up.physics.simulation`):
+    ``speed`` the physics settings' push speed (3 in/s), ``force`` the problem's force clip
+    (:func:`arrange_up.physics.settings.push_force`), ``kp_angle`` ``kp * r^2`` with ``r`` the
+    paddle's radius (the largest distance of its outline from its centroid: a force at its end
+    moves the end about as far by turning the paddle as a force at its centre moves the
+    centre) and ``torque`` ``force * r`` (the force clip at the paddle's end). ``kp``,
+    ``kp_angle`` and ``torque`` are used by ``compliant`` only.
+    """
+
+    kind: ControllerKind = ControllerKind.SERVO
+    kp: float = 300.0
+    """Proportional gain per axis (mass/s^2: force per inch of tracking error)."""
+    kp_angle: float | None = None
+    """Proportional gain on the angle (mass x in^2/s^2 per radian)."""
+    speed: float | None = None
+    """Speed of the set point along the push line (in/s); for ``servo`` its speed limit."""
+    force: float | None = None
+    """Clip of the force on each axis (mass x in/s^2); for ``servo`` on its magnitude."""
+    torque: float | None = None
+    """Clip of the torque (mass x in^2/s^2)."""
+
+
+DEFAULT_CONTROLLER = Controller()
+"""The controller of a problem that names none (and of every PDDL problem)."""
+
+
 @dataclass(frozen=True)
 class Table:
     """The manipulation surface: ``[0, width] x [0, depth]`` with rigid walls on some edges."""
@@ -212,6 +258,7 @@ class ArrangementProblem:
     goal: Goal
     uncertainty: Uncertainty = field(default_factory=Uncertainty)
     planning: PlanningHints = field(default_factory=PlanningHints)
+    controller: Controller = DEFAULT_CONTROLLER
     description: str = ""
     units: Units = field(default_factory=Units)
     source: str | None = None
@@ -253,10 +300,12 @@ class ArrangementProblem:
 def problem_hash(problem: ArrangementProblem) -> str:
     """A content hash of what the planner sees: ``"sha256:<hex>"``.
 
-    It covers the name, table, objects, initial belief, goal, uncertainty and planning hints in
-    internal units, with numbers rounded to 9 significant digits, so the same problem written in
-    other units or in another format (``.yaml`` or ``.pddl``) hashes the same. The description,
-    the file's units and its location are not part of the content.
+    It covers the name, table, objects, initial belief, goal, uncertainty, planning hints and
+    controller in internal units, with numbers rounded to 9 significant digits, so the same
+    problem written in other units or in another format (``.yaml`` or ``.pddl``) hashes the
+    same. The description, the file's units and its location are not part of the content; nor
+    is the controller when it is :data:`DEFAULT_CONTROLLER` (so problems that name none hash as
+    they did before the controller was part of the problem).
     """
 
     def canonical(value: object) -> object:
@@ -265,6 +314,7 @@ def problem_hash(problem: ArrangementProblem) -> str:
                 f.name: canonical(getattr(value, f.name))
                 for f in dataclasses.fields(value)
                 if f.name not in ("description", "units", "source")
+                and not (f.name == "controller" and getattr(value, f.name) == DEFAULT_CONTROLLER)
             }
         if isinstance(value, enum.Enum):
             return value.value

@@ -62,6 +62,7 @@ class _Body:
     part_moments: tuple[tuple[float, float], ...]  # (area_i, moment of part i per unit mass)
     abs_r: float  # integral(|r| dA) over the shape
     push_direction: tuple[float, float]
+    radius: float  # largest distance of a vertex from the centroid (the compliant wrist's lever)
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,7 @@ def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
             part_moments=tuple(zip(areas, moments, strict=True)),
             abs_r=sum(_abs_r_integral(part) for part in parts),
             push_direction=spec.push_direction,
+            radius=spec.shape.radius,
         )
     parts_area = sum(spec.shape.area for spec in problem.parts)  # as push_force sums it
     compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness, parts_area)

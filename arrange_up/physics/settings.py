@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.problem import STANDARD_GRAVITY, ArrangementProblem
 
 __all__ = ["DEFAULT_SETTINGS", "PhysicsSettings", "pd_gains", "push_force"]
 
@@ -31,7 +31,7 @@ class PhysicsSettings:
     corrects 20% per step at dt 1/240 (Box2D's Baumgarte factor; pymunk's default ``0.9 ** 60``
     is 2.6% per step and lets squeezed chains creep for a second, see
     :mod:`arrange_up.physics.simulation`)."""
-    gravity: float = 386.09
+    gravity: float = STANDARD_GRAVITY
     """Standard gravity in in/s^2; only the table friction uses it (the world is top-down)."""
     rest_interval: float = 0.1
     """Simulated time between rest checks (s); rounded to whole steps (24 at dt 1/240)."""

@@ -57,9 +57,10 @@ Model
   blocks spring apart, an artefact; with the brake, blocks end touching (overlaps within the
   slop). Figures: ``docs/design/physics.md``.
 
-The push controller
-===================
-The thesis drives the paddle with a clipped PD controller toward the reference point
+The push controller (servo)
+===========================
+The default controller (``problem.controller.kind == "servo"``). The thesis drives the paddle
+with a clipped PD controller toward the reference point
 ``ref = approach + distance * push_direction``::
 
     F = clip(Kp (ref - x) - Kd v),   Kd = sqrt(4 m Kp)  (critically damped).
@@ -104,6 +105,30 @@ of heavier parts raises the clip to 1.5 times the friction of all its parts at i
 densities reach 1.0, is affected (1608); its heaviest draws still stall the push, as the
 thesis's low-gain controller stalled.
 
+The compliant controller
+========================
+With ``problem.controller.kind == "compliant"`` (:class:`~arrange_up.model.problem.Controller`)
+the push runs the thesis's controller faithfully (§2.4.1): before every step the paddle gets the
+force and torque
+
+    F_x = clip(Kp (x_ref(t) - x) - Kd v_x),   F_y likewise,   Kd = sqrt(4 m Kp),
+    tau = clip(Kp_angle (theta_0 - theta) - Kd_angle omega),   Kd_angle = sqrt(4 I Kp_angle),
+
+(each axis clipped at ``force``, the torque at ``torque``; ``damping_ratio`` scales both Kd),
+where the set point ``x_ref(t)`` moves from the approach pose along the push line at ``speed``
+and stops ``distance`` along it: the thesis's real robot fed its low-gain controller
+intermediate set points along the pushing line, updated with time (§2.4.2). A PD toward the
+distant end point with no speed limit would be a catapult (the paddle reached 65-110 in/s and
+throws blocks; see ``docs/design/physics.md``). The paddle has its own moment here (a compliant
+wrist turns when a part meets it off-centre) and still no table friction. The drive runs until
+the set point has stopped and the paddle has been still (position and angle) for
+``rest_checks`` checks; then the robot holds the paddle (a pivot and a gear joint with no bias,
+clipped at ``force`` and ``torque``: the brake) until the other bodies are at rest. Under the
+low gain a resisted push stops short by about the resisting friction / Kp, growing with friction
+x mass; a free push ends at its target without overshoot (semi-implicit Euler of a critically
+damped PD at ``sqrt(Kp / m) dt`` ~ 0.19). Defaults (``Kp = 300``) and their measurements:
+``docs/design/physics.md``.
+
 Rest
 ====
 Rest is judged from pose change, not velocity (bodies being separated move while reporting zero
@@ -145,14 +170,21 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 # pymunk's cffi binding: the Chipmunk2D C API that pymunk's classes wrap (pymunk ~= 7.3).
 from pymunk._chipmunk_cffi import ffi, lib
 
 from arrange_up.geometry.se2 import rotate
-from arrange_up.model.problem import ArrangementProblem, ObjectKind, Pose, Table
+from arrange_up.model.problem import (
+    ArrangementProblem,
+    Controller,
+    ControllerKind,
+    ObjectKind,
+    Pose,
+    Table,
+)
 from arrange_up.model.world import (
     Action,
     ActionNoise,
@@ -177,8 +209,10 @@ __all__ = [
     "StepOutcome",
     "StepStatus",
     "pd_gains",
+    "compliant_gains",
     "push_force",
     "simulate",
+    "simulate_watched",
 ]
 
 
@@ -329,12 +363,19 @@ def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
 
 
 def _add_drive(
-    space, static, paddle, ref: tuple[float, float], settings: PhysicsSettings, force: float
+    space,
+    static,
+    paddle,
+    ref: tuple[float, float],
+    settings: PhysicsSettings,
+    force: float,
+    speed: float | None = None,
 ):
-    """The clipped PD of the push as a pivot joint, clipped at ``force`` (module docstring)."""
+    """The servo of the push as a pivot joint, clipped at ``force``, its speed limited to
+    ``speed`` (``settings.push_speed`` when ``None``; module docstring)."""
     joint = lib.cpPivotJointNew2(static, paddle, ref, (0.0, 0.0))
     lib.cpConstraintSetMaxForce(joint, force)
-    lib.cpConstraintSetMaxBias(joint, settings.push_speed)
+    lib.cpConstraintSetMaxBias(joint, settings.push_speed if speed is None else speed)
     lib.cpConstraintSetErrorBias(
         joint, (1.0 - settings.approach_rate * settings.dt) ** (1.0 / settings.dt)
     )
@@ -348,6 +389,7 @@ def _push(
     action: Push,
     noise: ActionNoise,
     s: PhysicsSettings,
+    watch: Callable[[list], None] | None = None,
 ) -> StepOutcome:
     name = action.manipulator
     kind = _spec_kind(compiled, name, "push")
@@ -445,10 +487,22 @@ def _push(
         ox, oy, oth = noise.pose_offset
         px, py, pth = action.pose
         px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
-        paddle = lib.cpBodyNew(noise.manipulator_density * paddle_def.area, math.inf)
+        controller = compiled.problem.controller
+        compliant = controller.kind is ControllerKind.COMPLIANT
+        rho_m = noise.manipulator_density
+        paddle_mass = rho_m * paddle_def.area
+        paddle_moment = math.inf
+        if compliant:
+            # The compliant wrist can turn: the paddle's own moment (same sum as the parts').
+            paddle_moment = 0.0
+            for area_i, unit_moment in paddle_def.part_moments:
+                paddle_moment += rho_m * area_i * unit_moment
+        paddle = lib.cpBodyNew(paddle_mass, paddle_moment)
         add_body(paddle, paddle_def, px, py, pth)
         dx, dy = rotate(paddle_def.push_direction, pth)
 
+        if watch is not None:
+            step = _watched_step(watch, bodies)
         # 4. settle, then look for overlaps in the contacts the engine built
         for _ in range(s.settle_steps):
             step(space, dt)
@@ -461,15 +515,41 @@ def _push(
         # steps; the other bodies are watched from the first check the paddle is still, so
         # their rest can count the check at which the drive stops (always followed by at
         # least one check with the brake on).
-        drive = _add_drive(
-            space,
-            static,
-            paddle,
-            (px + distance * dx, py + distance * dy),
-            s,
-            _force_clip(compiled.problem, compiled.parts_area, s),
-        )
-        constraints.append(drive)
+        force = _force_clip(compiled.problem, compiled.parts_area, s)
+        if compliant:
+            track = _Tracking(
+                controller,
+                s,
+                paddle,
+                paddle_mass,
+                paddle_moment,
+                paddle_def.radius,
+                force,
+                (px, py, pth),
+                (dx, dy),
+                step,
+            )
+            track.distance = distance
+            advance = track.advance
+            drive = None
+        else:
+            if controller.force is not None:
+                force = controller.force
+            drive = _add_drive(
+                space,
+                static,
+                paddle,
+                (px + distance * dx, py + distance * dy),
+                s,
+                force,
+                controller.speed,
+            )
+            constraints.append(drive)
+
+            def advance(n: int) -> None:
+                for _ in range(n):
+                    step(space, dt)
+
         interval = s.interval_steps
         max_steps = s.max_steps
         lin2 = s.rest_linear_tol * s.rest_linear_tol
@@ -485,22 +565,30 @@ def _push(
         travel = 0.0
         while True:
             if steps + interval > max_steps:
-                for _ in range(max_steps - steps):
-                    step(space, dt)
+                if driving:
+                    advance(max_steps - steps)
+                else:
+                    for _ in range(max_steps - steps):
+                        step(space, dt)
                 steps = max(steps, max_steps)
                 capped = True
                 if driving:
                     pos = get_pos(paddle)
                     last_x, last_y = pos.x, pos.y
                 break
-            for _ in range(interval):
-                step(space, dt)
+            if driving:
+                advance(interval)
+            else:
+                for _ in range(interval):
+                    step(space, dt)
             steps += interval
             if driving:
                 pos = get_pos(paddle)
                 ex, ey = pos.x - last_x, pos.y - last_y
                 last_x, last_y = pos.x, pos.y
-                if ex * ex + ey * ey < lin2:
+                # The compliant paddle must also have stopped turning, its set point at its end.
+                done = drive is not None or track.still(ang_tol)
+                if ex * ex + ey * ey < lin2 and done:
                     paddle_still += 1
                 else:
                     paddle_still = 0
@@ -522,8 +610,13 @@ def _push(
             if driving:
                 if paddle_still >= need:
                     driving = False
-                    set_max_bias(drive, 0.0)
+                    if drive is not None:
+                        set_max_bias(drive, 0.0)
+                    else:
+                        constraints.extend(track.brake(space, static))
                     travel = (last_x - px) * dx + (last_y - py) * dy
+                    if watch is not None:
+                        watch(None)  # the drive's end
             elif others_still >= need:
                 break
         if driving:  # capped while driving
@@ -556,6 +649,148 @@ def _push(
         manipulator_travel=travel,
         overlap=overlap,
     )
+
+
+class _Tracking:
+    """The compliant controller of one push (module docstring): per-axis clipped PD forces and
+    a clipped PD torque on the paddle, set before every step toward a set point that moves
+    from the approach pose along the push line at ``speed`` and stops ``distance`` along it.
+
+    pymunk clears a body's force and torque after each step, so :meth:`advance` sets them
+    before each one.
+    """
+
+    def __init__(
+        self,
+        controller: Controller,
+        settings: PhysicsSettings,
+        paddle,
+        mass: float,
+        moment: float,
+        radius: float,
+        default_force: float,
+        start: Pose,
+        direction: tuple[float, float],
+        step=lib.cpSpaceStep,
+    ) -> None:
+        gains = compliant_gains(controller, settings, mass, moment, radius, default_force)
+        self.kp, self.kd, self.kp_a, self.kd_a, self.force, self.torque, self.speed = gains
+        self.space_dt = settings.dt
+        self.paddle = paddle
+        self.start = start
+        self.direction = direction
+        self.distance = 0.0
+        self.k = 0  # steps driven
+        self.last_angle = start[2]
+        self.step = step
+
+    def advance(self, n: int) -> None:
+        """Run ``n`` steps, setting the controller's force and torque before each."""
+        body = self.paddle
+        step = self.step
+        space = lib.cpBodyGetSpace(body)
+        get_pos, get_vel = lib.cpBodyGetPosition, lib.cpBodyGetVelocity
+        get_angle, get_w = lib.cpBodyGetAngle, lib.cpBodyGetAngularVelocity
+        set_force, set_torque = lib.cpBodySetForce, lib.cpBodySetTorque
+        kp, kd, kp_a, kd_a = self.kp, self.kd, self.kp_a, self.kd_a
+        fmax, tmax = self.force, self.torque
+        x0, y0, th0 = self.start
+        ux, uy = self.direction
+        dt, reach = self.space_dt, self.speed * self.space_dt
+        distance = self.distance
+        k = self.k
+        for _ in range(n):
+            k += 1
+            along = min(k * reach, distance)
+            pos, vel = get_pos(body), get_vel(body)
+            fx = kp * (x0 + along * ux - pos.x) - kd * vel.x
+            fy = kp * (y0 + along * uy - pos.y) - kd * vel.y
+            tau = kp_a * (th0 - get_angle(body)) - kd_a * get_w(body)
+            set_force(body, (min(fmax, max(-fmax, fx)), min(fmax, max(-fmax, fy))))
+            set_torque(body, min(tmax, max(-tmax, tau)))
+            step(space, dt)
+        self.k = k
+
+    def still(self, tol: float) -> bool:
+        """Whether the set point has reached its end and the paddle turned less than ``tol``
+        since the last call (the caller judges its position)."""
+        angle = lib.cpBodyGetAngle(self.paddle)
+        turned = abs(angle - self.last_angle)
+        self.last_angle = angle
+        return self.k * self.speed * self.space_dt >= self.distance and turned < tol
+
+    def brake(self, space, static) -> list:
+        """Stop driving: hold the paddle where it is (pivot and gear with no bias, clipped at
+        the force and torque clips) while the other bodies come to rest."""
+        pivot = lib.cpPivotJointNew(static, self.paddle, lib.cpBodyGetPosition(self.paddle))
+        lib.cpConstraintSetMaxBias(pivot, 0.0)
+        lib.cpConstraintSetMaxForce(pivot, self.force)
+        lib.cpSpaceAddConstraint(space, pivot)
+        gear = lib.cpGearJointNew(static, self.paddle, 0.0, 1.0)
+        lib.cpConstraintSetMaxBias(gear, 0.0)
+        lib.cpConstraintSetMaxForce(gear, self.torque)
+        lib.cpSpaceAddConstraint(space, gear)
+        return [pivot, gear]
+
+
+def compliant_gains(
+    controller: Controller,
+    settings: PhysicsSettings,
+    mass: float,
+    moment: float,
+    radius: float,
+    default_force: float,
+) -> tuple[float, float, float, float, float, float, float]:
+    """``(Kp, Kd, Kp_angle, Kd_angle, force clip, torque clip, speed)`` of the compliant
+    controller for a paddle of ``mass``, ``moment`` and ``radius`` (the largest distance of
+    its outline from its centroid), the ``None`` fields of ``controller`` at their defaults
+    (:class:`~arrange_up.model.problem.Controller`): ``Kp_angle = Kp radius^2``, so that a
+    force at the paddle's end moves that end about as far by turning it as a force at its
+    centre moves the centre (a wrist as stiff as the arm), and ``torque = force * radius``;
+    ``Kd = damping_ratio * sqrt(4 m Kp)`` and likewise on the angle."""
+    kp = controller.kp
+    kp_a = kp * radius * radius if controller.kp_angle is None else controller.kp_angle
+    force = default_force if controller.force is None else controller.force
+    torque = force * radius if controller.torque is None else controller.torque
+    speed = settings.push_speed if controller.speed is None else controller.speed
+    zeta = settings.damping_ratio
+    kd = zeta * math.sqrt(4.0 * mass * kp)
+    kd_a = zeta * math.sqrt(4.0 * moment * kp_a)
+    return kp, kd, kp_a, kd_a, force, torque, speed
+
+
+def _watched_step(watch: Callable[[list], None], bodies: list):
+    """``cpSpaceStep`` followed by ``watch([(x, y, angle, vx, vy, w), ...])`` of ``bodies``
+    (the movable bodies in state order, then the paddle): for measurements only."""
+    step = lib.cpSpaceStep
+
+    def watched(space, dt: float) -> None:
+        step(space, dt)
+        out = []
+        for b in bodies:
+            p, v = lib.cpBodyGetPosition(b), lib.cpBodyGetVelocity(b)
+            out.append((p.x, p.y, lib.cpBodyGetAngle(b), v.x, v.y, lib.cpBodyGetAngularVelocity(b)))
+        watch(out)
+
+    return watched
+
+
+def simulate_watched(
+    problem: ArrangementProblem,
+    state: WorldState,
+    action: Push,
+    watch: Callable[[list | None], None],
+    noise: ActionNoise | None = None,
+    settings: PhysicsSettings = DEFAULT_SETTINGS,
+) -> StepOutcome:
+    """:func:`simulate` of a push, calling ``watch`` after every step with the pose and
+    velocity ``(x, y, angle, vx, vy, w)`` of every movable body in state order and then of the
+    manipulator (once with ``None`` when the drive ends). The same outcome as
+    :func:`simulate`, slower; for the controller's measurements (``benchmarks/controller.py``).
+    """
+    compiled = _compile(problem, settings.wall_thickness)
+    _check_state(compiled, state)
+    return _push(compiled, state, action, noise or nominal_noise(problem), settings, watch=watch)
 
 
 def _check_noise(noise: ActionNoise) -> None:

@@ -34,6 +34,15 @@ Distances:
 * to the part's goal coordinate along the direction, when that lies ahead;
 * each of ``planning.push_distances`` (how far the part should travel).
 
+Under the compliant controller (``problem.controller.kind == "compliant"``) a resisted push
+stops short of its set point by about the resisting friction / Kp, so the distances to a goal
+coordinate and the ``push_distances`` are lengthened by the nominal stall of what the push
+moves: ``mu g rho A / Kp`` at the middle of the friction and part-density ranges, ``A`` the area
+of the pushed part and of the parts in a row ahead of it whose shadows it would reach within
+``CONTACT_GAP`` (pushes to a wall need none: their set point lies beyond the wall, and the
+force clip presses the train against it). Under the servo the stall is zero and the distances
+are as before.
+
 A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
 such a push cannot help it, and it multiplies the search's plateaus.
 
@@ -53,8 +62,15 @@ from dataclasses import dataclass
 
 from arrange_up.belief.states import IntervalBelief, wrap_angle
 from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.model.problem import ArrangementProblem, ObjectKind, ObjectSpec, Pose
-from arrange_up.model.world import Action, Pick, Place, Push
+from arrange_up.model.problem import (
+    STANDARD_GRAVITY,
+    ArrangementProblem,
+    ControllerKind,
+    ObjectKind,
+    ObjectSpec,
+    Pose,
+)
+from arrange_up.model.world import Action, Pick, Place, Push, WorldState
 
 #: Direction name -> unit vector in the world frame.
 DIRECTIONS: dict[str, tuple[float, float]] = {
@@ -69,6 +85,13 @@ APPROACH_GAP = 0.02
 MIN_PUSH = 0.05
 #: Candidate distances closer than this are considered the same (inches).
 DISTANCE_RESOLUTION = 0.01
+#: Parts ahead of a pushed part within this gap (in) count as moved with it by the push, for
+#: the compliant controller's stall.
+CONTACT_GAP = 0.1
+#: Under the compliant controller: simulations per candidate push spent solving for its
+#: distance, and the error in the part's travel (in) at which the solver stops.
+SOLVER_STEPS = 3
+SOLVER_TOLERANCE = 0.002
 
 
 @dataclass(frozen=True)
@@ -99,6 +122,8 @@ class ActionGenerator:
         self.place_unc = problem.uncertainty.place
         self.push_unc = problem.uncertainty.push
         self.manipulators = tuple(_describe(spec) for spec in problem.manipulators)
+        self.stall_per_area = _stall_per_area(problem)
+        self.areas = {spec.name: spec.shape.area for spec in problem.parts}
         self.wall_trains = self._wall_trains()
         self.offsets = {
             spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
@@ -265,9 +290,12 @@ class ActionGenerator:
         for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
             pose = (along, across, theta) if axis == 0 else (across, along, theta)
             if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
-                pushes.extend(
-                    Push(manip.spec.name, _clean(pose), round(float(d), 4)) for d in distances
-                )
+                for d, travel in distances:
+                    push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
+                    if self.stall_per_area and travel is not None:
+                        distance = self._solve_distance(push, name, axis, sign, travel, belief)
+                        push = Push(push.manipulator, push.pose, distance)
+                    pushes.append(push)
         return pushes
 
     def _across(self, manip, name, interval, axis, sign, along, m_box, on_table) -> list[float]:
@@ -346,8 +374,11 @@ class ActionGenerator:
         high = size - APPROACH_GAP if high_name in walls else math.inf
         return low, high
 
-    def _distances(self, name, interval, belief, axis, sign, front) -> list[float]:
-        """Candidate travel distances of the manipulator (see the module docstring)."""
+    def _distances(
+        self, name, interval, belief, axis, sign, front
+    ) -> list[tuple[float, float | None]]:
+        """Candidate travel distances of the manipulator (see the module docstring), each with
+        the travel of the part it is meant for (``None`` for a push to the wall)."""
         size = self.problem.table.size[axis]
         wall = {(0, 1): "right", (0, -1): "left", (1, 1): "top", (1, -1): "bottom"}[(axis, sign)]
         nominal = self.checker.shadow_box(name, interval.center, (0.0, 0.0, 0.0))
@@ -364,16 +395,75 @@ class ActionGenerator:
             boundary = size if sign > 0 else 0.0
             candidates.append(sign * boundary - front)
         target = self.place_target(name, belief)
+        stall = self._stall(name, belief, axis, sign) if self.stall_per_area else 0.0
+        travels: dict[float, float | None] = {candidates[0]: None} if candidates else {}
         if target is not None:
             travel = sign * (target[axis] - interval.center[axis])
             if travel > MIN_PUSH:
-                candidates.append(gap + travel)
-        candidates.extend(gap + d for d in self.push_distances)
-        result: list[float] = []
-        for d in sorted(candidates):
-            if d > gap + MIN_PUSH and all(abs(d - r) > DISTANCE_RESOLUTION for r in result):
-                result.append(d)
+                travels.setdefault(gap + travel + stall, travel)
+        for d in self.push_distances:
+            travels.setdefault(gap + d + stall, d)
+        result: list[tuple[float, float | None]] = []
+        for d in sorted(travels):
+            if d > gap + MIN_PUSH and all(abs(d - r) > DISTANCE_RESOLUTION for r, _ in result):
+                result.append((d, travels[d]))
         return result
+
+    def _solve_distance(
+        self, push: Push, name: str, axis: int, sign: int, travel: float, belief: IntervalBelief
+    ) -> float:
+        """The distance at which ``push`` moves ``name`` by ``travel`` along its direction in a
+        noise-free simulation from the belief's centres, under the compliant controller: up to
+        ``SOLVER_STEPS`` fixed-point steps ``d += travel - achieved`` from ``push.distance``
+        (the stall changes little with the distance, so each step removes most of the error),
+        stopping within ``SOLVER_TOLERANCE``. A simulation that does not end at rest, or a
+        distance that falls to the free travel, keeps the last good distance."""
+        # Imported here: the physics (pymunk) costs ~55 ms to import, which importing the
+        # planner does not pay until a plan is made.
+        from arrange_up.physics.simulation import simulate
+
+        state = WorldState(tuple((n, iv.center) for n, iv in belief.objects))
+        start = belief.get(name).center[axis]  # type: ignore[union-attr]
+        distance = push.distance
+        for _ in range(SOLVER_STEPS):
+            outcome = simulate(self.problem, state, push)
+            if not outcome.ok or name not in outcome.state:
+                break
+            error = travel - sign * (outcome.state.as_dict()[name][axis] - start)
+            if abs(error) <= SOLVER_TOLERANCE or distance + error <= MIN_PUSH:
+                break
+            distance += error
+            push = Push(push.manipulator, push.pose, round(float(distance), 4))
+        return push.distance
+
+    def _stall(self, name: str, belief: IntervalBelief, axis: int, sign: int) -> float:
+        """The compliant controller's nominal stall pushing ``name`` (module docstring): the
+        pushed part and the row of parts ahead of it within ``CONTACT_GAP``, by nominal
+        boxes at the belief centres."""
+        other = 1 - axis
+        boxes = {
+            n: self.checker.shadow_box(n, iv.center, (0.0, 0.0, 0.0))
+            for n, iv in belief.objects
+            if n in self.areas
+        }
+        row, box = [name], boxes[name]
+        while True:
+            front = box[axis + 2] if sign > 0 else -box[axis]
+            ahead = [
+                (rear, q)
+                for q, b in boxes.items()
+                if q not in row
+                and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
+                and -1e-6
+                <= (rear := (b[axis] if sign > 0 else -b[axis + 2]) - front)
+                <= CONTACT_GAP
+            ]
+            if not ahead:
+                break
+            _, nearest = min(ahead)
+            row.append(nearest)
+            box = boxes[nearest]
+        return self.stall_per_area * sum(self.areas[q] for q in row)
 
     # -- pick ------------------------------------------------------------------------------
     def picks(self, belief: IntervalBelief) -> list[Pick]:
@@ -383,6 +473,18 @@ class ActionGenerator:
     # -- helpers ---------------------------------------------------------------------------
     def _shadows(self, belief: IntervalBelief):
         return [(name, iv.center, iv.half) for name, iv in belief.objects]
+
+
+def _stall_per_area(problem: ArrangementProblem) -> float:
+    """Inches a compliant push stops short per square inch of part it moves, at the middle of
+    the problem's friction and part-density ranges (``mu g rho / Kp``; 0 under the servo)."""
+    controller = problem.controller
+    if controller.kind is not ControllerKind.COMPLIANT:
+        return 0.0
+    u = problem.uncertainty
+    friction = 0.5 * (u.friction[0] + u.friction[1])
+    density = 0.5 * (u.part_density[0] + u.part_density[1])
+    return friction * STANDARD_GRAVITY * density / controller.kp
 
 
 def _describe(spec: ObjectSpec) -> _Manipulator:

@@ -1,0 +1,144 @@
+"""The push controllers: the servo as it always was, the compliant PD tracking a moving set
+point (stops short when resisted, never overshoots a free push), and the ``controller:`` key."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import pytest
+
+from arrange_up.io.yaml_problem import load_problem_text
+from arrange_up.model.errors import ProblemFormatError
+from arrange_up.model.problem import (
+    DEFAULT_CONTROLLER,
+    Controller,
+    ControllerKind,
+    ObjectKind,
+    problem_hash,
+)
+from arrange_up.model.world import ActionNoise, WorldState
+from arrange_up.physics.bench import scene
+from arrange_up.physics.simulation import simulate, simulate_watched
+
+COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
+
+
+def _noise(friction: float = 0.4, density: float = 0.125) -> ActionNoise:
+    return ActionNoise((0.0, 0.0, 0.0), friction, density, 0.4)
+
+
+def test_explicit_servo_is_the_default_and_hashes_alike():
+    problem, state, push = scene("1 block")
+    servo = replace(problem, controller=Controller(kind=ControllerKind.SERVO))
+    assert servo.controller == DEFAULT_CONTROLLER
+    assert problem_hash(servo) == problem_hash(problem)
+    assert simulate(servo, state, push, _noise()) == simulate(problem, state, push, _noise())
+    compliant = replace(problem, controller=COMPLIANT)
+    assert problem_hash(compliant) != problem_hash(problem)
+
+
+def test_compliant_free_push_ends_at_its_target_without_overshoot():
+    problem, _, push = scene("1 block")
+    alone = tuple(o for o in problem.objects if o.kind is ObjectKind.MANIPULATOR)
+    problem = replace(problem, objects=alone, controller=COMPLIANT)
+    furthest = []
+
+    def watch(bodies):
+        if bodies is not None:
+            furthest.append(bodies[-1][0] - push.pose[0])
+
+    outcome = simulate_watched(problem, WorldState(()), push, watch, _noise())
+    assert outcome.ok
+    assert outcome.manipulator_travel == pytest.approx(push.distance, abs=1e-3)
+    assert max(furthest) <= push.distance + 1e-3
+
+
+def test_compliant_resisted_push_stops_short_more_under_more_friction_and_mass():
+    problem, state, push = scene("1 block")
+    servo = simulate(problem, state, push, _noise())
+    problem = replace(problem, controller=COMPLIANT)
+    light = simulate(problem, state, push, _noise(0.25, 0.1))
+    heavy = simulate(problem, state, push, _noise(0.55, 0.15))
+    assert servo.manipulator_travel == pytest.approx(push.distance, abs=1e-3)
+    short_light = push.distance - light.manipulator_travel
+    short_heavy = push.distance - heavy.manipulator_travel
+    assert 0.0 < short_light < short_heavy
+    # about friction / Kp: mu m g / Kp (the block's momentum carries it a little further)
+    assert short_heavy == pytest.approx(0.55 * 0.15 * 386.09 / COMPLIANT.kp, rel=0.5)
+
+
+def test_compliant_paddle_turns_against_its_controller_off_centre():
+    problem, state, push = scene("1 block")
+    x, y, th = push.pose
+    push = replace(push, pose=(x, y + 1.0, th))  # the block meets the paddle's end
+    problem = replace(problem, controller=COMPLIANT)
+    angles = []
+    simulate_watched(
+        problem, state, push, lambda b: b is None or angles.append(b[-1][2]), _noise(0.55)
+    )
+    assert max(abs(a - th) for a in angles) > 1e-3
+
+
+_FILE = """
+name: c
+units: {length: cm}
+table: {size: [25.4, 12.7]}
+objects:
+  b: {kind: part, shape: {box: [2.54, 2.54]}}
+  paddle: {kind: manipulator, shape: {box: [6.35, 0.381]}}
+initial:
+  b: {pose: [7.62, 6.35, 0]}
+goal:
+  poses: {b: [12.7, 6.35, 0]}
+"""
+
+
+def test_controller_mapping_in_file_units():
+    problem = load_problem_text(_FILE + "controller: {kind: compliant, kp: 200, speed: 2.54}\n")
+    assert problem.controller.kind is ControllerKind.COMPLIANT
+    assert problem.controller.kp == 200.0
+    assert problem.controller.speed == pytest.approx(1.0)
+    assert load_problem_text(_FILE).controller == DEFAULT_CONTROLLER
+
+
+@pytest.mark.parametrize(
+    ("mapping", "message"),
+    [
+        ("{kind: compliant, kpp: 3}", "unknown controller key 'kpp' (did you mean 'kp'?)"),
+        ("{kind: stiff}", "expected compliant or servo"),
+        ("{kind: servo, kp: 300}", "'kp' tunes the compliant controller only"),
+        ("{kind: compliant, force: -1}", "expected a positive force"),
+    ],
+)
+def test_controller_mapping_errors(mapping, message):
+    with pytest.raises(ProblemFormatError) as error:
+        load_problem_text(_FILE + f"controller: {mapping}\n")
+    assert message in str(error.value)
+    assert "controller" in str(error.value)
+
+
+def test_default_angle_gain_makes_the_wrist_as_stiff_as_the_arm():
+    from arrange_up.physics.simulation import DEFAULT_SETTINGS, compliant_gains
+
+    kp, kd, kp_a, kd_a, force, torque, speed = compliant_gains(
+        COMPLIANT, DEFAULT_SETTINGS, 0.15, 0.08, 1.25, 400.0
+    )
+    # a force F at the paddle's end (1.25 in out) turns it by F r / Kp_angle, moving the end
+    # F r^2 / Kp_angle: as far as F moves the centre, F / Kp
+    assert 1.25 * 1.25 / kp_a == pytest.approx(1.0 / kp)
+    assert kd == pytest.approx(math.sqrt(4 * 0.15 * kp))
+    assert kd_a == pytest.approx(math.sqrt(4 * 0.08 * kp_a))
+    assert (force, speed) == (400.0, DEFAULT_SETTINGS.push_speed)
+    assert torque == pytest.approx(400.0 * 1.25)
+
+
+def test_plan_files_record_a_controller_that_is_not_the_default():
+    from arrange_up.io.planfile import plan_document
+
+    servo = load_problem_text(_FILE)
+    compliant = load_problem_text(_FILE + "controller: {kind: compliant, speed: 2.54}\n")
+    kw = {"status": "solved", "semantics": "deterministic", "seed": 0, "search": {}}
+    assert "controller" not in plan_document(servo, (), **kw)
+    recorded = plan_document(compliant, (), **kw)["controller"]
+    assert recorded == {"kind": "compliant", "kp": 300.0, "speed": 2.54}  # in the file's cm
