@@ -1,3 +1,3 @@
-"""Former import path, kept so existing imports work: see :mod:`arrange_up.evaluation.evaluate`."""
+"""Former import path, kept so existing imports work: see :mod:`arrange_up.evaluation`."""
 
-from arrange_up.evaluation.evaluate import *  # noqa: F403
+from arrange_up.evaluation import *  # noqa: F403

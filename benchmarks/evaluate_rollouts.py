@@ -30,7 +30,8 @@ from pathlib import Path
 
 from joblib import Parallel, delayed, parallel_config
 
-from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.records import plan_hash
 from arrange_up.evaluation.rollouts import RolloutContext, rollout_task
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic

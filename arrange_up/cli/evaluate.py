@@ -27,14 +27,10 @@ from arrange_up.cli.shared import (
     seed_option,
     terminal_progress,
 )
-from arrange_up.evaluation.evaluate import (
-    LANDINGS,
-    EvaluationProgress,
-    FailureBreakdown,
-    RecordFileError,
-    evaluate_plan,
-    plan_hash,
-)
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.records import RecordFileError, plan_hash
+from arrange_up.evaluation.reliability import EvaluationProgress, FailureBreakdown
+from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action, Push
 from arrange_up.parallel import BackendUnavailableError

@@ -4,4 +4,18 @@ their outcomes (:mod:`~arrange_up.evaluation.outcomes`), the resumable record fi
 (:mod:`~arrange_up.evaluation.reliability`), gathered by :func:`evaluate_plan`
 (:mod:`~arrange_up.evaluation.evaluate`)."""
 
-from arrange_up.evaluation.evaluate import *  # noqa: F403  (every public name of the evaluation)
+from arrange_up.evaluation import evaluate, outcomes, records, reliability, rollouts
+from arrange_up.evaluation.evaluate import *  # noqa: F403
+from arrange_up.evaluation.outcomes import *  # noqa: F403
+from arrange_up.evaluation.records import *  # noqa: F403
+from arrange_up.evaluation.reliability import *  # noqa: F403
+from arrange_up.evaluation.rollouts import *  # noqa: F403
+
+#: Every public name of the evaluation room, as the former module ``arrange_up.evaluate`` had.
+__all__ = [
+    *outcomes.__all__,
+    *reliability.__all__,
+    *records.__all__,
+    *rollouts.__all__,
+    *evaluate.__all__,
+]

@@ -35,91 +35,30 @@ from functools import partial
 from pathlib import Path
 
 from arrange_up.evaluation.outcomes import (
-    ACTION_FAILED,
-    FAILURE_KINDS,
-    GOAL_MISSED,
-    NOT_AT_REST,
-    OFF_TABLE,
-    Failure,
-    FailureKind,
-    GoalMiss,
     RolloutRecord,
 )
 from arrange_up.evaluation.records import (
-    RECORD_FORMAT,
     RecordFile,
-    RecordFileError,
     plan_hash,
     record_header,
 )
 from arrange_up.evaluation.reliability import (
-    Z95,
-    ActionCount,
-    ActionFailureCount,
     EvaluationProgress,
     FailureBreakdown,
-    GoalMissCount,
-    OffTableCount,
     ProgressCallback,
     Reliability,
-    wilson_interval,
 )
 from arrange_up.evaluation.rollouts import (
-    LANDINGS,
-    PUSH_OVERLAP_REASON,
-    Execution,
     RolloutContext,
-    Rollouts,
     check_landing,
-    execute_plan,
     rollout_task,
-    simulate_rollout,
-    trace_rollout,
 )
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, problem_hash
 from arrange_up.model.world import Action, Pick, Place, Push
 from arrange_up.parallel import BACKENDS, auto_chunksize, get_runner
 from arrange_up.physics.simulation import DEFAULT_SETTINGS
 
-__all__ = [
-    "ACTION_FAILED",
-    "FAILURE_KINDS",
-    "GOAL_MISSED",
-    "LANDINGS",
-    "NOT_AT_REST",
-    "OFF_TABLE",
-    "PUSH_OVERLAP_REASON",
-    "RECORD_FORMAT",
-    "Z95",
-    "ActionCount",
-    "ActionFailureCount",
-    "EvaluationProgress",
-    "Execution",
-    "Failure",
-    "FailureBreakdown",
-    "FailureKind",
-    "GoalMiss",
-    "GoalMissCount",
-    "OffTableCount",
-    "ProgressCallback",
-    "RecordFile",
-    "RecordFileError",
-    "Reliability",
-    "RolloutContext",
-    "RolloutRecord",
-    "Rollouts",
-    "evaluate_plan",
-    "execute_plan",
-    "plan_hash",
-    "record_header",
-    "rollout_task",
-    "simulate_rollout",
-    "trace_rollout",
-    "wilson_interval",
-]
-
-#: The former private name of :class:`~arrange_up.evaluation.records.RecordFile`.
-_RecordFile = RecordFile
+__all__ = ["evaluate_plan"]
 
 
 def evaluate_plan(

@@ -48,7 +48,8 @@ from typing import Any
 
 from matplotlib.patches import Patch
 
-from arrange_up.evaluation.evaluate import evaluate_plan, plan_hash
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.records import plan_hash
 from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
 from arrange_up.figures.backend import pyplot
 from arrange_up.io.domains import load

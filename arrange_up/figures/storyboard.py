@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from arrange_up.evaluation.evaluate import trace_rollout
+from arrange_up.evaluation.rollouts import trace_rollout
 from arrange_up.figures.backend import figure_format, pyplot
 from arrange_up.figures.scene import (
     describe,

@@ -119,7 +119,9 @@ from unified_planning.model.state import State
 from unified_planning.plans import Plan, PlanKind
 
 from arrange_up.belief.goals import GoalTest
-from arrange_up.evaluation.evaluate import GOAL_MISSED, EvaluationProgress, evaluate_plan
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.outcomes import GOAL_MISSED
+from arrange_up.evaluation.reliability import EvaluationProgress
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Place, Push
 from arrange_up.planning import planner

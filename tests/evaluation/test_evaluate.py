@@ -14,22 +14,18 @@ import pytest
 from click.testing import CliRunner
 
 from arrange_up.cli import main
-from arrange_up.evaluation.evaluate import (
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.outcomes import (
     ACTION_FAILED,
     GOAL_MISSED,
     NOT_AT_REST,
     OFF_TABLE,
-    EvaluationProgress,
-    RecordFileError,
     RolloutRecord,
-    _RecordFile,
-    evaluate_plan,
-    execute_plan,
-    plan_hash,
-    simulate_rollout,
-    trace_rollout,
-    wilson_interval,
 )
+from arrange_up.evaluation.records import RecordFile as _RecordFile
+from arrange_up.evaluation.records import RecordFileError, plan_hash
+from arrange_up.evaluation.reliability import EvaluationProgress, wilson_interval
+from arrange_up.evaluation.rollouts import execute_plan, simulate_rollout, trace_rollout
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, write_json_atomic
 from arrange_up.model.problem import (

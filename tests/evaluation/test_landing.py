@@ -7,8 +7,9 @@ import math
 
 import pytest
 
-from arrange_up.evaluation.evaluate import PUSH_OVERLAP_REASON, evaluate_plan
+from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.records import RecordFileError
+from arrange_up.evaluation.rollouts import PUSH_OVERLAP_REASON
 from arrange_up.io.domains import load
 from arrange_up.model.world import Place, Push
 

@@ -11,7 +11,7 @@ import pytest
 from catalogue import tiny
 
 from arrange_up.belief.states import ParticleBelief
-from arrange_up.evaluation.evaluate import trace_rollout
+from arrange_up.evaluation.rollouts import trace_rollout
 from arrange_up.figures.backend import pyplot
 from arrange_up.figures.scene import describe
 from arrange_up.figures.storyboard import (
