@@ -60,8 +60,10 @@ SCALED_DOWN: dict[str, str] = {
     "arrange-up train-cbst --examples 1800 --rollouts-per-example 100": (
         "arrange-up train-cbst --examples 10 --rollouts-per-example 2"
     ),
-    "arrange-up show blocks-3 --plan b3.json --rollouts 30 -o blocks-3-storyboard.png": (
-        "arrange-up show blocks-3 --plan b3.json --rollouts 5 -o blocks-3-storyboard.png"
+    "arrange-up show blocks-3 --plan b3.json --rollouts 30 -o blocks-3-storyboard.png "
+    "--animate blocks-3.gif": (
+        "arrange-up show blocks-3 --plan b3.json --rollouts 5 -o blocks-3-storyboard.png "
+        "--animate blocks-3.gif"
     ),
     "arrange-up bench physics": "arrange-up bench physics --pushes 10 --workers 1",
 }
