@@ -34,7 +34,13 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
 
-__all__ = ["DEFAULT_GOAL_TOLERANCE_IN", "FORMAT_VERSION", "SUPPORTED_FORMATS", "ProblemBuilder"]
+__all__ = [
+    "DEFAULT_GOAL_TOLERANCE_IN",
+    "FORMAT_VERSION",
+    "MAX_PROBLEM_VERTICES",
+    "SUPPORTED_FORMATS",
+    "ProblemBuilder",
+]
 
 FORMAT_VERSION = "arrange-up/1"
 #: The ``format:`` values this loader reads.
@@ -65,6 +71,10 @@ UNCERTAINTY_KEYS = ("place", "push", "friction", "part_density", "manipulator_de
 KIND_NAMES = tuple(kind.value for kind in ObjectKind)
 _ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
 _ARTICLE["obstacle"] = "an obstacle"
+#: Most polygon vertices (``polygon`` and ``convex_parts`` forms together) a problem may have:
+#: ten polygons at the per-polygon cap (``geometry.MAX_POLYGON_VERTICES``). Bounds the time of
+#: checking a problem; tabletop problems have a few hundred.
+MAX_PROBLEM_VERTICES = 10_000
 
 
 @dataclass
@@ -82,6 +92,10 @@ class _Object:
 
 class ProblemBuilder(NodeReader):
     """Builds the problem of one parsed file, section by section (see the module docstring)."""
+
+    #: Polygon vertices read so far (``polygon`` and ``convex_parts`` forms), against
+    #: :data:`MAX_PROBLEM_VERTICES`.
+    vertices = 0
 
     # -- the whole file ----------------------------------------------------------------------
     def build(self, root: Node) -> ArrangementProblem | None:
@@ -339,6 +353,22 @@ class ProblemBuilder(NodeReader):
             self.error(
                 node, f"expected a polygon [[x, y], ...] with at least 3 vertices, got {got}"
             )
+            return None
+        if len(node.value) > geometry.MAX_POLYGON_VERTICES:
+            self.error(
+                node,
+                f"a polygon has {len(node.value)} vertices; expected at most "
+                f"{geometry.MAX_POLYGON_VERTICES} (simplify the outline)",
+            )
+            return None
+        self.vertices += len(node.value)
+        if self.vertices > MAX_PROBLEM_VERTICES:
+            if self.vertices - len(node.value) <= MAX_PROBLEM_VERTICES:  # report it once
+                self.error(
+                    node,
+                    f"the polygons so far have {self.vertices} vertices in all; expected at "
+                    f"most {MAX_PROBLEM_VERTICES} in a problem (simplify the outlines)",
+                )
             return None
         values = [self.vector(item, ("x", "y")) for item in node.items()]
         if any(v is None for v in values):
