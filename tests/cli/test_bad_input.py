@@ -432,6 +432,6 @@ def test_plan_refuses_a_polygon_over_the_vertex_cap_with_exit_2(tmp_path: Path) 
     assert result.exit_code == 2, result.output
     assert result.exception is None or isinstance(result.exception, SystemExit)
     assert (
-        f"{path}:4:{column}: error: objects.A.shape.polygon: a polygon has {n} vertices; expected at "
-        f"most {MAX_POLYGON_VERTICES}" in result.output
+        f"{path}:4:{column}: error: objects.A.shape.polygon: a polygon has {n} vertices; "
+        f"expected at most {MAX_POLYGON_VERTICES}" in result.output
     )
