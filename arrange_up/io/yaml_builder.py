@@ -354,29 +354,34 @@ class ProblemBuilder(NodeReader):
                 node, f"expected a polygon [[x, y], ...] with at least 3 vertices, got {got}"
             )
             return None
-        if len(node.value) > geometry.MAX_POLYGON_VERTICES:
-            self.error(
-                node,
-                f"a polygon has {len(node.value)} vertices; expected at most "
-                f"{geometry.MAX_POLYGON_VERTICES} (simplify the outline)",
-            )
-            return None
-        self.vertices += len(node.value)
-        if self.vertices > MAX_PROBLEM_VERTICES:
-            if self.vertices - len(node.value) <= MAX_PROBLEM_VERTICES:  # report it once
-                self.error(
-                    node,
-                    f"the polygons so far have {self.vertices} vertices in all; expected at "
-                    f"most {MAX_PROBLEM_VERTICES} in a problem (simplify the outlines)",
-                )
-            return None
+        # Refused before its vertices are read (one extra entry may be a closing vertex).
+        if len(node.value) > geometry.MAX_POLYGON_VERTICES + 1:
+            return self.too_many_vertices(node, len(node.value))
         values = [self.vector(item, ("x", "y")) for item in node.items()]
         if any(v is None for v in values):
             return None
         points = [(self.units.length_in(v[0]), self.units.length_in(v[1])) for v in values]  # type: ignore[index]
         if len(points) > 3 and points[-1] == points[0]:
             points.pop()  # an explicitly closed outline: the closing vertex repeats the first
+        if len(points) > geometry.MAX_POLYGON_VERTICES:
+            return self.too_many_vertices(node, len(points))
+        self.vertices += len(points)
+        if self.vertices > MAX_PROBLEM_VERTICES:
+            if self.vertices - len(points) <= MAX_PROBLEM_VERTICES:  # report it once
+                self.error(
+                    node,
+                    f"the polygons so far have {self.vertices} vertices in all; expected at "
+                    f"most {MAX_PROBLEM_VERTICES} in a problem (simplify the outlines)",
+                )
+            return None
         return points
+
+    def too_many_vertices(self, node: Node, count: int) -> None:
+        self.error(
+            node,
+            f"a polygon has {count} vertices; expected at most "
+            f"{geometry.MAX_POLYGON_VERTICES} (simplify the outline)",
+        )
 
     def valid_polygon(self, node: Node, points: list[Point], what: str) -> bool:
         try:

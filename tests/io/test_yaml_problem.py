@@ -1265,3 +1265,10 @@ def test_refuses_a_problem_of_more_polygon_vertices_than_the_cap(
         "objects.B.shape.polygon",
         "the polygons so far have 8 vertices in all; expected at most 7 in a problem",
     )
+
+
+def test_a_closing_vertex_does_not_count_against_the_cap(tmp_path: Path) -> None:
+    n = geometry.MAX_POLYGON_VERTICES
+    closed = f"{_regular_polygon(n)}, [3.000000, 2.000000]"
+    path = write(tmp_path, MINIMAL.replace("{box: [1, 1]}", f"{{polygon: [{closed}]}}"))
+    assert len(load_problem(path).object("A").shape.parts) == 1
