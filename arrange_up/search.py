@@ -66,11 +66,13 @@ import itertools
 import math
 import random
 import time
+from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass, replace
 from typing import Any, Generic, Protocol, TypeVar
 
 __all__ = [
+    "DEAD_END_CACHE",
     "PROGRESS_INTERVAL",
     "Edge",
     "SearchResult",
@@ -88,6 +90,10 @@ A = TypeVar("A")
 
 #: Seconds between two calls of the ``progress`` callback (it is also called once at the end).
 PROGRESS_INTERVAL = 0.2
+#: Dead ends (states of infinite heuristic) whose value the search remembers, most recently
+#: seen first. Accepted states are kept anyway (duplicate detection needs them); dead ends are
+#: not, and caching every one kept each pruned state's belief alive for the whole search.
+DEAD_END_CACHE = 4096
 
 
 class SearchStatus(enum.StrEnum):
@@ -296,8 +302,10 @@ class _Search:
         self.g_best: dict[Any, float] = {}
         # States expanded at least once (value: g of the last expansion).
         self.closed: dict[Any, float] = {}
-        # The heuristic may be as expensive as a successor, so each state is evaluated once.
+        # The heuristic may be as expensive as a successor, so each accepted state is evaluated
+        # once, and a dead end once while it stays among the DEAD_END_CACHE most recent.
         self.h_cache: dict[Any, float] = {}
+        self.dead_ends: OrderedDict[Any, None] = OrderedDict()
         # Dominance buckets: key -> {accepted state: its best g}. A dict per bucket so that a
         # state reached again more cheaply updates its g in place.
         self.buckets: dict[Hashable, dict[Any, float]] = {}
@@ -342,13 +350,20 @@ class _Search:
             return None
         h = self.h_cache.get(state)
         if h is None:
+            if state in self.dead_ends:
+                self.dead_ends.move_to_end(state)
+                stats.pruned_infinite += 1
+                return None
             h = float(self.heuristic(state))
             if math.isnan(h):
                 raise ValueError(f"heuristic returned NaN for state {state!r}")
+            if h == math.inf:
+                self.dead_ends[state] = None
+                if len(self.dead_ends) > DEAD_END_CACHE:
+                    self.dead_ends.popitem(last=False)
+                stats.pruned_infinite += 1
+                return None
             self.h_cache[state] = h
-        if h == math.inf:
-            stats.pruned_infinite += 1
-            return None
         stats.best_h = min(stats.best_h, h)
         self.g_best[state] = g
         if bucket is not None:
@@ -514,7 +529,9 @@ def best_first_search(
         Goal test, applied when a node is selected for expansion (never at generation).
     heuristic
         Estimate of the remaining cost; ``math.inf`` marks a dead end (the state is pruned).
-        Called at most once per distinct state (values are cached). Default: blind (0).
+        Must be a function of the state: values are cached, finite ones for as long as the
+        search runs, dead ends in a cache of the :data:`DEAD_END_CACHE` most recently seen
+        (a dead end met again after leaving it is evaluated again). Default: blind (0).
     weight
         Open list ordered by ``f = g + weight * h``: 1 is A*, > 1 weighted A* (plans cost at
         most ``weight`` times the optimum for an admissible heuristic), 0 uniform cost. Ignored

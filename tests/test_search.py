@@ -670,3 +670,30 @@ def test_invalid_arguments() -> None:
         best_first_search(0, line_successors, lambda n: n == 3, dominance_key=lambda n: n)
     with pytest.raises(ValueError):
         best_first_search(0, line_successors, lambda n: n == 3, lambda n: math.nan)
+
+
+@pytest.mark.parametrize(("dead_ends", "evaluations"), [(2, 2), (3, 12)])
+def test_dead_ends_are_remembered_in_a_bounded_recent_cache(
+    monkeypatch: pytest.MonkeyPatch, dead_ends: int, evaluations: int
+) -> None:
+    """Each of the 12 steps of a line also leads to one of ``dead_ends`` dead ends, in turn.
+    With room for two: two dead ends are evaluated once each; three, met in turn, each leave
+    the cache before they come back, so every meeting evaluates the heuristic again. The
+    search itself (plan, counts) is the same either way."""
+    monkeypatch.setattr("arrange_up.search.DEAD_END_CACHE", 2)
+    calls: list[object] = []
+
+    def successors(n: object) -> list[Edge[object, str]]:
+        assert isinstance(n, int)
+        return [Edge.known("+", 1.0, n + 1), Edge.known("x", 1.0, ("dead", n % dead_ends))]
+
+    def heuristic(s: object) -> float:
+        if isinstance(s, tuple):
+            calls.append(s)
+            return math.inf
+        return 0.0
+
+    result = best_first_search(0, successors, lambda n: n == 12, heuristic)
+    assert result.solved() and len(result.plan) == 12
+    assert result.stats.pruned_infinite == 12
+    assert len(calls) == evaluations

@@ -172,27 +172,56 @@ def dominates(a: IntervalBelief, b: IntervalBelief, tol: float = 1e-9) -> bool:
 
 
 # -- particle beliefs --------------------------------------------------------------------------
-@dataclass(frozen=True)
 class ParticleBelief:
     """A set of world states with the same objects on the table (thesis §2.1.2).
 
     ``particles[i]`` keeps its index across transitions, so particle ``i``'s noise can be
     drawn from ``(seed, i, step)`` and a plan's belief sequence is reproducible.
+
+    Stored as one read-only float array of every particle's poses (:attr:`poses`) and the
+    names of the objects on the table: a search holds thousands of beliefs, and the poses as
+    Python tuples took some 300 bytes each against 24 in the array. :attr:`particles` builds
+    the :class:`WorldState` values from the array when asked (the same floats). Beliefs are
+    equal (and hash equal) when their names and every pose coordinate are equal.
     """
 
-    particles: tuple[WorldState, ...]
-
-    def __post_init__(self) -> None:
-        if not self.particles:
+    def __init__(self, particles: Sequence[WorldState]) -> None:
+        if not particles:
             raise ValueError("a particle belief needs at least one particle")
+        self._names = particles[0].names()
+        poses = np.array([[pose for _, pose in s.poses] for s in particles], dtype=float)
+        #: Array ``(P, n_objects, 3)`` of every particle's poses, in ``names()`` order.
+        self.poses = poses.reshape(len(particles), len(self._names), 3)
+        self.poses.flags.writeable = False
+        # -0.0 == 0.0, so hash the array with its zeros made positive (adding 0.0 does that).
+        self._hash = hash((self._names, (self.poses + 0.0).tobytes()))
 
     def names(self) -> tuple[str, ...]:
-        return self.particles[0].names()
+        return self._names
 
-    @cached_property
-    def poses(self) -> np.ndarray:
-        """Array ``(P, n_objects, 3)`` of every particle's poses, in ``names()`` order."""
-        return np.array([[pose for _, pose in s.poses] for s in self.particles], dtype=float)
+    @property
+    def particles(self) -> tuple[WorldState, ...]:
+        """The particles as world states (built anew on every access)."""
+        names = self._names
+        return tuple(
+            WorldState(tuple((name, tuple(pose)) for name, pose in zip(names, state, strict=True)))
+            for state in self.poses.tolist()
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, ParticleBelief):
+            return NotImplemented
+        return (
+            self._hash == other._hash
+            and self._names == other._names
+            and bool(np.array_equal(self.poses, other.poses))
+        )
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __repr__(self) -> str:
+        return f"ParticleBelief({len(self)} particles of {', '.join(self._names) or 'nothing'})"
 
     @cached_property
     def intervals(self) -> IntervalBelief:
@@ -209,7 +238,7 @@ class ParticleBelief:
         )
 
     def __len__(self) -> int:
-        return len(self.particles)
+        return len(self.poses)
 
 
 def sample_initial_particles(

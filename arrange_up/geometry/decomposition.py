@@ -1,10 +1,12 @@
 """Convex decomposition of simple polygons: ear-clipping triangulation, then Hertel-Mehlhorn
-merging. Pure Python on the polygon's own vertices (no new points, no snapping)."""
+merging, on the polygon's own vertices (no new points, no snapping)."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+
+import numpy as np
 
 from arrange_up.geometry.polygons import (
     Polygon,
@@ -20,6 +22,10 @@ from arrange_up.geometry.se2 import Point
 # the rounding of coordinates that were typed as decimals.
 _COLLINEAR_SIN = 1e-12
 
+#: Polygons of at most this many vertices get the best of 12 triangulations; bigger ones (far
+#: beyond any tabletop part's outline) one, so that their decomposition costs a twelfth.
+_SEVERAL_STARTS_UP_TO = 64
+
 __all__ = ["decompose_convex"]
 
 
@@ -30,9 +36,19 @@ def _turn_sin(a: Point, b: Point, c: Point) -> float:
     return _cross3(a, b, c) / (la * lc)
 
 
-def _in_triangle(p: Point, a: Point, b: Point, c: Point) -> bool:
-    """Whether ``p`` is inside or on the boundary of the CCW triangle ``abc``."""
-    return _cross3(a, b, p) >= 0.0 and _cross3(b, c, p) >= 0.0 and _cross3(c, a, p) >= 0.0
+def _cross_all(a: Point, b: Point, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """:func:`_cross3` ``(a, b, p)`` for every point ``p = (x[k], y[k])``, with the same
+    floating-point operations in the same order (so the same bits)."""
+    return (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
+
+
+def _in_triangle_all(x: np.ndarray, y: np.ndarray, a: Point, b: Point, c: Point) -> np.ndarray:
+    """Which points ``(x[k], y[k])`` are inside or on the boundary of the CCW triangle ``abc``."""
+    return (
+        (_cross_all(a, b, x, y) >= 0.0)
+        & (_cross_all(b, c, x, y) >= 0.0)
+        & (_cross_all(c, a, x, y) >= 0.0)
+    )
 
 
 def _ear_clip(pts: Polygon, start: int = 0) -> list[tuple[int, int, int]]:
@@ -43,14 +59,18 @@ def _ear_clip(pts: Polygon, start: int = 0) -> list[tuple[int, int, int]]:
     Straight (collinear) vertices are never ears, so no degenerate triangle is produced; they
     are clipped as corners of their neighbours' ears instead. Ears that are nearly straight are
     taken only when nothing better exists, to avoid sliver triangles. ``start`` rotates where
-    the search begins, which gives different (equally valid) triangulations. O(n^3), fine for
-    object outlines of tens of vertices.
+    the search begins, which gives different (equally valid) triangulations. O(n^3) in the worst
+    case, each ear test one vectorised pass over the remaining vertices; polygons are capped at
+    :data:`~arrange_up.geometry.polygons.MAX_POLYGON_VERTICES` vertices.
     """
     n = len(pts)
+    xy = np.asarray(pts, dtype=float)
     idx = list(range(start, n)) + list(range(start))
     tris: list[tuple[int, int, int]] = []
     while len(idx) > 3:
         m = len(idx)
+        rest = xy[idx]
+        x, y = rest[:, 0], rest[:, 1]
         clipped = False
         for min_sin in (1e-9, 0.0):
             for k in range(m):
@@ -58,7 +78,9 @@ def _ear_clip(pts: Polygon, start: int = 0) -> list[tuple[int, int, int]]:
                 a, b, c = pts[i0], pts[i1], pts[i2]
                 if _turn_sin(a, b, c) <= min_sin:
                     continue
-                if any(_in_triangle(pts[j], a, b, c) for j in idx if j not in (i0, i1, i2)):
+                inside = _in_triangle_all(x, y, a, b, c)
+                inside[[k - 1, k, (k + 1) % m]] = False  # the ear's own corners
+                if inside.any():
                     continue
                 tris.append((i0, i1, i2))
                 del idx[k]
@@ -127,7 +149,8 @@ def decompose_convex(poly: Sequence[Point]) -> tuple[Polygon, ...]:
     Method: ear-clipping triangulation, then Hertel–Mehlhorn merging across diagonals. A few
     triangulations (ear search started at different vertices) are tried and the one giving the
     fewest pieces is kept, which finds the obvious decompositions (e.g. a tee in 2 or 3 pieces)
-    that a single arbitrary triangulation can miss. Deterministic.
+    that a single arbitrary triangulation can miss; a polygon of more than 64 vertices gets one
+    triangulation. Deterministic.
 
     Raises
     ------
@@ -142,7 +165,8 @@ def decompose_convex(poly: Sequence[Point]) -> tuple[Polygon, ...]:
         return (pts,)
     n = len(pts)
     best: list[list[int]] | None = None
-    for start in range(min(n, 12)):
+    starts = 12 if n <= _SEVERAL_STARTS_UP_TO else 1
+    for start in range(min(n, starts)):
         pieces = _hertel_mehlhorn(pts, _ear_clip(pts, start))
         if best is None or len(pieces) < len(best):
             best = pieces

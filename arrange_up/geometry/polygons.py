@@ -21,7 +21,16 @@ Polygon = tuple[Point, ...]
 
 _TAU = 2.0 * math.pi
 
+#: Most vertices a polygon may have. Tabletop parts have tens; the cap keeps every polygon
+#: operation's cost bounded (validity is quadratic in the vertex count, decomposition worse), so
+#: a huge outline is refused with a message instead of exhausting time or memory.
+MAX_POLYGON_VERTICES = 1000
+#: Segment pairs tested at once by the self-intersection test: bounds its temporary arrays
+#: (about a hundred bytes a pair) whatever the vertex count.
+_PAIRS_PER_CHUNK = 1 << 16
+
 __all__ = [
+    "MAX_POLYGON_VERTICES",
     "Polygon",
     "box_polygon",
     "convex_penetration",
@@ -155,6 +164,8 @@ def polygon_problem(poly: Sequence[Point]) -> str | None:
 
     * ``"is not a sequence of (x, y) points"``
     * ``"has fewer than 3 vertices"``
+    * ``"has N vertices, more than the MAX vertices a polygon may have"`` (see
+      :data:`MAX_POLYGON_VERTICES`); tested before any work that grows faster than the count
     * ``"has non-finite coordinates"`` (NaN or infinity)
     * ``"has repeated consecutive vertices"`` (including last == first: polygons are given
       without a closing vertex)
@@ -172,6 +183,8 @@ def polygon_problem(poly: Sequence[Point]) -> str | None:
     n = len(p)
     if n < 3:
         return "has fewer than 3 vertices"
+    if n > MAX_POLYGON_VERTICES:
+        return f"has {n} vertices, more than the {MAX_POLYGON_VERTICES} vertices a polygon may have"
     if not np.all(np.isfinite(p)):
         return "has non-finite coordinates"
     nxt = np.roll(p, -1, axis=0)
@@ -191,12 +204,15 @@ def polygon_problem(poly: Sequence[Point]) -> str | None:
     if np.any((turn == 0.0) & (back < 0.0)):
         return "intersects itself"
     if n > 3:
-        # All pairs of non-adjacent edges at once; edge i runs from p[i] to p[i+1].
-        i, j = np.triu_indices(n, k=2)
-        keep = ~((i == 0) & (j == n - 1))  # edges 0 and n-1 are adjacent (share p[0])
-        i, j = i[keep], j[keep]
-        if np.any(_segments_intersect(p[i], nxt[i], p[j], nxt[j])):
-            return "intersects itself"
+        # Every pair of non-adjacent edges (edge i runs from p[i] to p[i+1]), a block of
+        # edges i at a time against all edges j >= i + 2, so memory stays bounded.
+        rows = max(1, _PAIRS_PER_CHUNK // n)
+        for first in range(0, n - 2, rows):
+            i, j = np.meshgrid(np.arange(first, min(first + rows, n - 2)), np.arange(n))
+            keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))  # edges 0 and n-1 share p[0]
+            i, j = i[keep], j[keep]
+            if np.any(_segments_intersect(p[i], nxt[i], p[j], nxt[j])):
+                return "intersects itself"
     if polygon_signed_area(p) == 0.0:  # unreachable in exact arithmetic; a rounding safety net
         return "is degenerate (zero area)"
     return None

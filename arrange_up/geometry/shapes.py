@@ -29,6 +29,7 @@ from arrange_up.geometry.boxes import (
 )
 from arrange_up.geometry.decomposition import decompose_convex
 from arrange_up.geometry.polygons import (
+    MAX_POLYGON_VERTICES,
     Polygon,
     _points_array,
     box_polygon,
@@ -51,6 +52,7 @@ from arrange_up.geometry.shadows import (
 )
 
 __all__ = [
+    "MAX_POLYGON_VERTICES",
     "Box",
     "HalfWidths",
     "Point",

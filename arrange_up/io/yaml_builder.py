@@ -37,7 +37,13 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
 
-__all__ = ["DEFAULT_GOAL_TOLERANCE_IN", "FORMAT_VERSION", "SUPPORTED_FORMATS", "ProblemBuilder"]
+__all__ = [
+    "DEFAULT_GOAL_TOLERANCE_IN",
+    "FORMAT_VERSION",
+    "MAX_PROBLEM_VERTICES",
+    "SUPPORTED_FORMATS",
+    "ProblemBuilder",
+]
 
 FORMAT_VERSION = "arrange-up/1"
 #: The ``format:`` values this loader reads.
@@ -72,6 +78,10 @@ UNCERTAINTY_KEYS = ("place", "push", "friction", "part_density", "manipulator_de
 KIND_NAMES = tuple(kind.value for kind in ObjectKind)
 _ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
 _ARTICLE["obstacle"] = "an obstacle"
+#: Most polygon vertices (``polygon`` and ``convex_parts`` forms together) a problem may have:
+#: ten polygons at the per-polygon cap (``geometry.MAX_POLYGON_VERTICES``). Bounds the time of
+#: checking a problem; tabletop problems have a few hundred.
+MAX_PROBLEM_VERTICES = 10_000
 
 
 @dataclass
@@ -89,6 +99,10 @@ class _Object:
 
 class ProblemBuilder(NodeReader):
     """Builds the problem of one parsed file, section by section (see the module docstring)."""
+
+    #: Polygon vertices read so far (``polygon`` and ``convex_parts`` forms), against
+    #: :data:`MAX_PROBLEM_VERTICES`.
+    vertices = 0
 
     # -- the whole file ----------------------------------------------------------------------
     def build(self, root: Node) -> ArrangementProblem | None:
@@ -349,13 +363,34 @@ class ProblemBuilder(NodeReader):
                 node, f"expected a polygon [[x, y], ...] with at least 3 vertices, got {got}"
             )
             return None
+        # Refused before its vertices are read (one extra entry may be a closing vertex).
+        if len(node.value) > geometry.MAX_POLYGON_VERTICES + 1:
+            return self.too_many_vertices(node, len(node.value))
         values = [self.vector(item, ("x", "y")) for item in node.items()]
         if any(v is None for v in values):
             return None
         points = [(self.units.length_in(v[0]), self.units.length_in(v[1])) for v in values]  # type: ignore[index]
         if len(points) > 3 and points[-1] == points[0]:
             points.pop()  # an explicitly closed outline: the closing vertex repeats the first
+        if len(points) > geometry.MAX_POLYGON_VERTICES:
+            return self.too_many_vertices(node, len(points))
+        self.vertices += len(points)
+        if self.vertices > MAX_PROBLEM_VERTICES:
+            if self.vertices - len(points) <= MAX_PROBLEM_VERTICES:  # report it once
+                self.error(
+                    node,
+                    f"the polygons so far have {self.vertices} vertices in all; expected at "
+                    f"most {MAX_PROBLEM_VERTICES} in a problem (simplify the outlines)",
+                )
+            return None
         return points
+
+    def too_many_vertices(self, node: Node, count: int) -> None:
+        self.error(
+            node,
+            f"a polygon has {count} vertices; expected at most "
+            f"{geometry.MAX_POLYGON_VERTICES} (simplify the outline)",
+        )
 
     def valid_polygon(self, node: Node, points: list[Point], what: str) -> bool:
         try:

@@ -99,3 +99,27 @@ def test_initial_particles_are_collision_free_and_reproducible():
     assert not any(checker.state_collides(s) for s in a.particles)
     poses = a.poses
     assert np.all(np.abs(poses[:, 0, :2] - [4, 4]) <= 0.3 + 1e-12)
+
+
+def test_particle_belief_stores_an_array_and_rebuilds_equal_world_states() -> None:
+    states = (
+        WorldState((("A", (1.0, 2.0, 0.5)), ("B", (3.0, 4.0, -0.0)))),
+        WorldState((("A", (1.5, 2.0, 0.25)), ("B", (3.0, 4.5, 0.0)))),
+    )
+    belief = ParticleBelief(states)
+    assert belief.particles == states
+    assert belief.names() == ("A", "B") and len(belief) == 2
+    assert belief.poses.shape == (2, 2, 3) and not belief.poses.flags.writeable
+    # -0.0 == 0.0, so beliefs that differ only in a zero's sign are equal and hash equal.
+    same = ParticleBelief(
+        (states[0], WorldState((("A", (1.5, 2.0, 0.25)), ("B", (3.0, 4.5, -0.0)))))
+    )
+    assert same == belief and hash(same) == hash(belief)
+    moved = ParticleBelief(
+        (states[0], WorldState((("A", (1.5, 2.0, 0.25)), ("B", (3.0, 4.5, 1e-300)))))
+    )
+    assert moved != belief
+    renamed = ParticleBelief(tuple(WorldState((("C", s.poses[0][1]), s.poses[1])) for s in states))
+    assert renamed != belief
+    with pytest.raises(ValueError, match="at least one particle"):
+        ParticleBelief(())

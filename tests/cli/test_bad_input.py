@@ -10,6 +10,7 @@ names where the problem is and what was expected, and without an exception escap
 from __future__ import annotations
 
 import json
+import math
 import re
 import textwrap
 from pathlib import Path
@@ -18,6 +19,7 @@ import pytest
 from click.testing import CliRunner
 
 from arrange_up.cli import main
+from arrange_up.geometry.polygons import MAX_POLYGON_VERTICES
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -410,3 +412,26 @@ def test_the_cases_are_as_many_as_reported():
     files = len(YAML_CASES) + len(PDDL_CASES) + len(PLAN_CASES)
     assert files >= 60 and len(COMMAND_CASES) >= 40
     assert all(re.fullmatch(r"[a-z0-9-]+", c) for c in [*YAML_CASES, *PDDL_CASES, *PLAN_CASES])
+
+
+def test_plan_refuses_a_polygon_over_the_vertex_cap_with_exit_2(tmp_path: Path) -> None:
+    """The cap is checked before any quadratic work: refused quickly, with the file's place."""
+    n = MAX_POLYGON_VERTICES + 1
+    vertices = ", ".join(
+        f"[{2 + math.cos(2 * math.pi * k / n):.6f}, {2 + math.sin(2 * math.pi * k / n):.6f}]"
+        for k in range(n)
+    )
+    path = tmp_path / "big.yaml"
+    path.write_text(
+        "name: big\ntable: {size: [10, 5]}\nobjects:\n"
+        f"  A: {{kind: part, shape: {{polygon: [{vertices}]}}}}\n"
+        "goal:\n  tolerance: [0.2, 0.2]\n  poses: {A: [5, 2, 0]}\n"
+    )
+    column = path.read_text().splitlines()[3].index("[[") + 1
+    result = _invoke(["plan", str(path), "--semantics", "deterministic"])
+    assert result.exit_code == 2, result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+    assert (
+        f"{path}:4:{column}: error: objects.A.shape.polygon: a polygon has {n} vertices; "
+        f"expected at most {MAX_POLYGON_VERTICES}" in result.output
+    )

@@ -10,6 +10,7 @@ import pytest
 import shapely
 
 from arrange_up.geometry.shapes import (
+    MAX_POLYGON_VERTICES,
     ShapeVertices,
     box_contains,
     box_of,
@@ -447,3 +448,30 @@ def test_wall_boxes():
     assert wall_boxes((10.0, 6.0), []) == {}
     with pytest.raises(ValueError, match="unknown wall"):
         wall_boxes((10.0, 6.0), ["front"])
+
+
+def test_polygon_problem_refuses_more_vertices_than_the_cap() -> None:
+    n = MAX_POLYGON_VERTICES + 1
+    circle = [(math.cos(2 * math.pi * k / n), math.sin(2 * math.pi * k / n)) for k in range(n)]
+    assert polygon_problem(circle) == (
+        f"has {n} vertices, more than the {MAX_POLYGON_VERTICES} vertices a polygon may have"
+    )
+    assert polygon_problem(circle[:-1]) is None
+
+
+def test_self_intersection_found_across_chunks_of_a_big_polygon() -> None:
+    # A 1000-vertex star whose vertex 10 is pulled across the outline to beyond vertex 510:
+    # its edges cross edges some 500 apart, in another block of the chunked pair test.
+    n = MAX_POLYGON_VERTICES
+    star = [
+        (
+            (1.0 if k % 2 else 0.8) * math.cos(2 * math.pi * k / n),
+            (1.0 if k % 2 else 0.8) * math.sin(2 * math.pi * k / n),
+        )
+        for k in range(n)
+    ]
+    assert polygon_problem(star) is None
+    pulled = list(star)
+    pulled[10] = (1.5 * star[510][0], 1.5 * star[510][1])
+    assert polygon_problem(pulled) == "intersects itself"
+    assert not shapely.Polygon(pulled).is_valid  # an independent opinion

@@ -1217,3 +1217,58 @@ def test_diagnostic_format() -> None:
     )
     error = ProblemFormatError([diagnostic, warning])
     assert str(error) == f"{diagnostic}\n{warning}"
+
+
+def _regular_polygon(n: int) -> str:
+    return ", ".join(
+        f"[{2 + math.cos(2 * math.pi * k / n):.6f}, {2 + math.sin(2 * math.pi * k / n):.6f}]"
+        for k in range(n)
+    )
+
+
+def test_refuses_a_polygon_of_more_vertices_than_the_cap(tmp_path: Path) -> None:
+    n = geometry.MAX_POLYGON_VERTICES + 1
+    path = write(
+        tmp_path, MINIMAL.replace("{box: [1, 1]}", f"{{polygon: [{_regular_polygon(n)}]}}")
+    )
+    refused_with(
+        path,
+        where(path, "[[3."),
+        "objects.A.shape.polygon",
+        f"a polygon has {n} vertices; expected at most {geometry.MAX_POLYGON_VERTICES}",
+    )
+
+
+def test_accepts_a_polygon_at_the_cap(tmp_path: Path) -> None:
+    n = geometry.MAX_POLYGON_VERTICES
+    path = write(
+        tmp_path, MINIMAL.replace("{box: [1, 1]}", f"{{polygon: [{_regular_polygon(n)}]}}")
+    )
+    problem = load_problem(path)
+    assert len(problem.object("A").shape.parts) == 1  # a regular polygon is convex
+
+
+def test_refuses_a_problem_of_more_polygon_vertices_than_the_cap(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The cap is 10,000; a file that big is slow to build, so the test lowers it to 7 and
+    # gives two 4-vertex polygons: the second one passes the cap and is the one reported.
+    monkeypatch.setattr("arrange_up.io.yaml_builder.MAX_PROBLEM_VERTICES", 7)
+    square = "{polygon: [[0, 0], [1, 0], [1, 1], [0, 1]]}"
+    text = MINIMAL.replace("{box: [1, 1]}", square).replace(
+        "    goal:", f"      B: {{kind: part, shape: {square.replace('0]', '0.0]')}}}\n    goal:"
+    )
+    path = write(tmp_path, text)
+    refused_with(
+        path,
+        where(path, "[[0, 0.0]"),
+        "objects.B.shape.polygon",
+        "the polygons so far have 8 vertices in all; expected at most 7 in a problem",
+    )
+
+
+def test_a_closing_vertex_does_not_count_against_the_cap(tmp_path: Path) -> None:
+    n = geometry.MAX_POLYGON_VERTICES
+    closed = f"{_regular_polygon(n)}, [3.000000, 2.000000]"
+    path = write(tmp_path, MINIMAL.replace("{box: [1, 1]}", f"{{polygon: [{closed}]}}"))
+    assert len(load_problem(path).object("A").shape.parts) == 1
