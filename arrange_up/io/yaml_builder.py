@@ -10,30 +10,31 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any
 
-from arrange_up.geometry import shapes as geometry
 from arrange_up.io import validation
-from arrange_up.io.shape_forms import box_shape, ccw_polygon, centred_shape, convex_decomposition
 from arrange_up.io.validation import Placed
-from arrange_up.io.yaml_source import Node, NodeReader, at, describe, fmt, is_number, suggest
+from arrange_up.io.yaml_settings import (
+    SettingsReader,
+)
+from arrange_up.io.yaml_shapes import MAX_PROBLEM_VERTICES, SHAPE_EXPECTED, ShapeReader
+from arrange_up.io.yaml_source import (
+    Node,
+    NodeReader,
+    Report,
+    at,
+    describe,
+    fmt,
+)
 from arrange_up.model.problem import (
-    DEFAULT_CONTROLLER,
     WALL_EDGES,
     ArrangementProblem,
-    Controller,
-    ControllerKind,
-    ConvexPolygon,
     Goal,
     InitialObject,
     ObjectKind,
     ObjectSpec,
-    PlanningHints,
-    Point,
     Pose,
     Shape,
     Table,
-    Uncertainty,
 )
 from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
 
@@ -67,21 +68,9 @@ TOP_LEVEL_KEYS = (
     "planning",
     "controller",
 )
-SHAPE_FORMS = ("box", "polygon", "convex_parts")
-SHAPE_EXPECTED = "{box: [w, h]}, {polygon: [...]}, {convex_parts: [...]}"
-PUSH_DIRECTIONS = ("+x", "-x", "+y", "-y")
-PLANNING_KEYS = ("place_offsets", "place_angles", "push_distances", "push_directions", "max_nodes")
-CONTROLLER_KEYS = ("kind", "kp", "kp_angle", "speed", "force", "torque")
-#: Keys the servo controller reads (the others tune the compliant controller only).
-SERVO_KEYS = ("kind", "speed", "force")
-UNCERTAINTY_KEYS = ("place", "push", "friction", "part_density", "manipulator_density")
 KIND_NAMES = tuple(kind.value for kind in ObjectKind)
 _ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
 _ARTICLE["obstacle"] = "an obstacle"
-#: Most polygon vertices (``polygon`` and ``convex_parts`` forms together) a problem may have:
-#: ten polygons at the per-polygon cap (``geometry.MAX_POLYGON_VERTICES``). Bounds the time of
-#: checking a problem; tabletop problems have a few hundred.
-MAX_PROBLEM_VERTICES = 10_000
 
 
 @dataclass
@@ -98,11 +87,13 @@ class _Object:
 
 
 class ProblemBuilder(NodeReader):
-    """Builds the problem of one parsed file, section by section (see the module docstring)."""
+    """Builds the problem of one parsed file, section by section (see the module docstring);
+    shapes and the settings sections are read by their own readers into the same report."""
 
-    #: Polygon vertices read so far (``polygon`` and ``convex_parts`` forms), against
-    #: :data:`MAX_PROBLEM_VERTICES`.
-    vertices = 0
+    def __init__(self, report: Report) -> None:
+        super().__init__(report)
+        self.shape_reader = ShapeReader(report)
+        self.settings_reader = SettingsReader(report)
 
     # -- the whole file ----------------------------------------------------------------------
     def build(self, root: Node) -> ArrangementProblem | None:
@@ -115,14 +106,15 @@ class ProblemBuilder(NodeReader):
         if root.has("units"):
             self.units = self.read_units(root.child("units"))
         table = self.table(root)
-        shapes = self.shapes(root)
+        self.shape_reader.units = self.settings_reader.units = self.units
+        shapes = self.shape_reader.shapes(root)
         objects = self.objects(root, shapes)
         initial = self.initial(root, objects)
         self.check_placement(table, objects, initial)
         goal = self.goal(root, objects)
-        uncertainty = self.uncertainty(root)
-        planning = self.planning(root)
-        controller = self.controller(root)
+        uncertainty = self.settings_reader.uncertainty(root)
+        planning = self.settings_reader.planning(root)
+        controller = self.settings_reader.controller(root)
 
         if table is not None and goal is not None:
             self.check_goal_on_table(root, table, objects, goal)
@@ -295,162 +287,6 @@ class ProblemBuilder(NodeReader):
                 chosen[str(item.value)] = item
         return tuple(e for e in WALL_EDGES if e in chosen) if ok else None
 
-    # -- shapes ---------------------------------------------------------------------------------
-    def shapes(self, root: Node) -> dict[str, Shape | None]:
-        """Named shapes; a name maps to ``None`` when its shape was invalid (already reported)."""
-        shapes: dict[str, Shape | None] = {}
-        if not root.has("shapes"):
-            return shapes
-        node = root.child("shapes")
-        if not self.mapping(node, "a mapping from shape names to shapes", null_ok=True):
-            return shapes
-        if node.is_null:
-            return shapes
-        for key_node, value_node in node.entries():
-            if not isinstance(key_node.value, str):
-                self.error(
-                    key_node, f"expected a shape name (a string), got {describe(key_node.value)}"
-                )
-                continue
-            shapes[str(key_node.value)] = self.shape_form(value_node, str(key_node.value))
-        return shapes
-
-    def shape_form(self, node: Node, name: str | None) -> Shape | None:
-        """A shape given as ``{box: ...}``, ``{polygon: ...}`` or ``{convex_parts: ...}``."""
-        if not node.is_map:
-            self.error(
-                node, f"expected a shape: one of {SHAPE_EXPECTED}; got {describe(node.value)}"
-            )
-            return None
-        self.warn_unknown(node, SHAPE_FORMS, "a shape")
-        forms = [key for key in SHAPE_FORMS if node.has(key)]
-        if not forms:
-            self.error(
-                node,
-                f"a shape needs exactly one of box, polygon or convex_parts; "
-                f"expected one of {SHAPE_EXPECTED}",
-            )
-            return None
-        if len(forms) > 1:
-            self.error(
-                node.key(forms[1]),
-                f"a shape has exactly one of box, polygon or convex_parts; found both "
-                f"{forms[0]!r} and {forms[1]!r}",
-            )
-            return None
-        form = forms[0]
-        child = node.child(form)
-        if form == "box":
-            return self.box(child, name)
-        if form == "polygon":
-            return self.polygon(child, name)
-        return self.convex_parts(child, name)
-
-    def box(self, node: Node, name: str | None) -> Shape | None:
-        size = self.positive(node, self.vector(node, ("width", "height")), "box size")
-        if size is None:
-            return None
-        width, height = (self.units.length_in(v) for v in size)
-        return box_shape(width, height, name)
-
-    def points(self, node: Node) -> list[Point] | None:
-        """A polygon's vertices ``[[x, y], ...]`` (at least three), converted to inches."""
-        if not node.is_seq or len(node.value) < 3:
-            got = describe(node.value)
-            if node.is_seq:
-                got = f"{len(node.value)} vertices"
-            self.error(
-                node, f"expected a polygon [[x, y], ...] with at least 3 vertices, got {got}"
-            )
-            return None
-        # Refused before its vertices are read (one extra entry may be a closing vertex).
-        if len(node.value) > geometry.MAX_POLYGON_VERTICES + 1:
-            return self.too_many_vertices(node, len(node.value))
-        values = [self.vector(item, ("x", "y")) for item in node.items()]
-        if any(v is None for v in values):
-            return None
-        points = [(self.units.length_in(v[0]), self.units.length_in(v[1])) for v in values]  # type: ignore[index]
-        if len(points) > 3 and points[-1] == points[0]:
-            points.pop()  # an explicitly closed outline: the closing vertex repeats the first
-        if len(points) > geometry.MAX_POLYGON_VERTICES:
-            return self.too_many_vertices(node, len(points))
-        self.vertices += len(points)
-        if self.vertices > MAX_PROBLEM_VERTICES:
-            if self.vertices - len(points) <= MAX_PROBLEM_VERTICES:  # report it once
-                self.error(
-                    node,
-                    f"the polygons so far have {self.vertices} vertices in all; expected at "
-                    f"most {MAX_PROBLEM_VERTICES} in a problem (simplify the outlines)",
-                )
-            return None
-        return points
-
-    def too_many_vertices(self, node: Node, count: int) -> None:
-        self.error(
-            node,
-            f"a polygon has {count} vertices; expected at most "
-            f"{geometry.MAX_POLYGON_VERTICES} (simplify the outline)",
-        )
-
-    def valid_polygon(self, node: Node, points: list[Point], what: str) -> bool:
-        try:
-            reason = geometry.polygon_problem(tuple(points))
-        except Exception as error:  # geometry must not leak a traceback for odd input
-            reason = f"cannot be analysed ({error})"
-        if reason:
-            self.error(
-                node,
-                f"{what} {reason}; expected a simple polygon (vertices in order around its "
-                "boundary, no self-intersections, non-zero area)",
-            )
-            return False
-        return True
-
-    def polygon(self, node: Node, name: str | None) -> Shape | None:
-        points = self.points(node)
-        if points is None or not self.valid_polygon(node, points, "the polygon"):
-            return None
-        try:
-            parts = convex_decomposition(points)
-        except Exception as error:
-            self.error(node, f"the polygon could not be decomposed into convex parts ({error})")
-            return None
-        return centred_shape(parts, name)
-
-    def convex_parts(self, node: Node, name: str | None) -> Shape | None:
-        items = self.list_of(node, "a non-empty list of convex polygons [[[x, y], ...], ...]")
-        if items is None:
-            return None
-        parts: list[tuple[int, Node, ConvexPolygon]] = []
-        ok = True
-        for index, item in enumerate(items):
-            points = self.points(item)
-            if points is None or not self.valid_polygon(item, points, f"part [{index}]"):
-                ok = False
-                continue
-            if not geometry.is_convex(tuple(points)):
-                self.error(
-                    item,
-                    f"part [{index}] is not convex; expected convex polygons (use 'polygon:' "
-                    "to have a non-convex shape decomposed for you)",
-                )
-                ok = False
-                continue
-            parts.append((index, item, ccw_polygon(points)))
-        area_unit = self.units.length_factor**2
-        for i, j, overlap in validation.part_overlaps([p for _, _, p in parts]):
-            (index_i, _, _), (index_j, node_j, _) = parts[i], parts[j]
-            self.error(
-                node_j,
-                f"parts [{index_i}] and [{index_j}] overlap (area "
-                f"{fmt(overlap / area_unit)} {self.units.length}²); the convex parts of "
-                "a shape may touch but not overlap",
-            )
-            ok = False
-        if not ok:
-            return None
-        return centred_shape(tuple(p for _, _, p in parts), name)
-
     # -- objects --------------------------------------------------------------------------------
     def objects(self, root: Node, shapes: dict[str, Shape | None]) -> dict[str, _Object]:
         objects: dict[str, _Object] = {}
@@ -553,7 +389,7 @@ class ProblemBuilder(NodeReader):
             self.error(node, f"unknown shape {name!r}; expected {choices}{SHAPE_EXPECTED}{extra}")
             return None
         if node.is_map:
-            return self.shape_form(node, None)
+            return self.shape_reader.shape_form(node, None)
         self.error(
             node,
             f"expected the name of a shape declared under 'shapes' or an inline "
@@ -800,197 +636,3 @@ class ProblemBuilder(NodeReader):
                 continue
             targets.append((obj.name, pose))
         return tuple(targets) if ok else None
-
-    # -- uncertainty ----------------------------------------------------------------------------
-    def uncertainty(self, root: Node) -> Uncertainty | None:
-        default = Uncertainty()
-        if not root.has("uncertainty"):
-            return default
-        node = root.child("uncertainty")
-        if not self.mapping(
-            node, "a mapping with any of " + ", ".join(UNCERTAINTY_KEYS), null_ok=True
-        ):
-            return None
-        if node.is_null:
-            return default
-        self.warn_unknown(node, UNCERTAINTY_KEYS, "'uncertainty'")
-        values: dict[str, Any] = {}
-        ok = True
-        for key in ("place", "push"):
-            if node.has(key):
-                values[key] = self.half_widths(node.child(key))
-                ok &= values[key] is not None
-        units = self.units
-        # densities must be positive: a body of zero mass cannot be simulated
-        for key, convert, positive in (
-            ("friction", float, False),
-            ("part_density", units.density_in, True),
-            ("manipulator_density", units.density_in, True),
-        ):
-            if node.has(key):
-                values[key] = self.range(node.child(key), convert, positive=positive)
-                ok &= values[key] is not None
-        friction = values.get("friction")
-        if friction is not None and friction[1] > validation.MAX_FRICTION:
-            self.report.warning(
-                node.child("friction"),
-                None,
-                f"friction up to {fmt(friction[1])} is far above real table-top materials "
-                f"(below ~1.5); every push will stick. Expected at most "
-                f"{fmt(validation.MAX_FRICTION)}: check the value",
-            )
-        return Uncertainty(**values) if ok else None
-
-    # -- planning hints -------------------------------------------------------------------------
-    def planning(self, root: Node) -> PlanningHints | None:
-        if not root.has("planning"):
-            return PlanningHints()
-        node = root.child("planning")
-        if not self.mapping(
-            node, "a mapping of planning hints (" + ", ".join(PLANNING_KEYS) + ")", null_ok=True
-        ):
-            return None
-        if node.is_null:
-            return PlanningHints()
-        ok = True
-        for key_node, _ in node.entries():
-            if key_node.value not in PLANNING_KEYS:
-                self.error(
-                    key_node,
-                    f"unknown planning hint {key_node.value!r}"
-                    f"{suggest(key_node.value, PLANNING_KEYS)}; expected one of "
-                    f"{', '.join(PLANNING_KEYS)} (a misspelt hint would silently change "
-                    "planning)",
-                )
-                ok = False
-        hints: dict[str, Any] = {}
-        units = self.units
-        if node.has("place_offsets"):
-            items = self.list_of(node.child("place_offsets"), "a non-empty list of [dx, dy]")
-            offsets = None if items is None else [self.vector(i, ("dx", "dy")) for i in items]
-            if offsets is None or any(o is None for o in offsets):
-                ok = False
-            else:
-                hints["place_offsets"] = tuple(
-                    (units.length_in(o[0]), units.length_in(o[1]))  # type: ignore[index]
-                    for o in offsets
-                )
-        if node.has("place_angles"):
-            child = node.child("place_angles")
-            numbers = self.numbers(child, "angle", positive=False)
-            angles = None
-            if numbers is not None:
-                angles = [self.angle(i, v) for i, v in zip(child.items(), numbers, strict=True)]
-            ok &= angles is not None and None not in angles
-            if ok and angles is not None:
-                hints["place_angles"] = tuple(angles)
-        if node.has("push_distances"):
-            numbers = self.numbers(node.child("push_distances"), "distance", positive=True)
-            ok &= numbers is not None
-            if numbers is not None:
-                hints["push_distances"] = tuple(units.length_in(v) for v in numbers)
-        if node.has("push_directions"):
-            directions = self.push_directions(node.child("push_directions"))
-            ok &= directions is not None
-            hints["push_directions"] = directions
-        if node.has("max_nodes"):
-            child = node.child("max_nodes")
-            value = child.value
-            if is_number(value) and isinstance(value, int) and value > 0:
-                hints["max_nodes"] = int(value)
-            else:
-                self.error(child, f"expected a positive whole number, got {describe(value)}")
-                ok = False
-        return PlanningHints(**hints) if ok else None
-
-    # -- the push controller --------------------------------------------------------------------
-    def controller(self, root: Node) -> Controller | None:
-        """The ``controller:`` mapping (``docs/problem-format.md``), converted to internal units:
-        ``kp`` in mass/s^2 needs no conversion, ``speed`` is a length per second, ``force`` a
-        mass x length/s^2, ``torque`` a mass x length^2/s^2 and ``kp_angle`` a torque per angle
-        unit."""
-        if not root.has("controller"):
-            return DEFAULT_CONTROLLER
-        node = root.child("controller")
-        if not self.mapping(
-            node, "a mapping {kind: compliant | servo, ...} (" + ", ".join(CONTROLLER_KEYS) + ")"
-        ):
-            return None
-        ok = True
-        for key_node, _ in node.entries():
-            if key_node.value not in CONTROLLER_KEYS:
-                # An error, not a warning: a misspelt gain would silently change the physics.
-                self.error(
-                    key_node,
-                    f"unknown controller key {key_node.value!r}"
-                    f"{suggest(key_node.value, CONTROLLER_KEYS)}; expected one of "
-                    f"{', '.join(CONTROLLER_KEYS)}",
-                )
-                ok = False
-        kinds = tuple(kind.value for kind in ControllerKind)
-        kind: ControllerKind | None = DEFAULT_CONTROLLER.kind
-        if node.has("kind"):
-            kind_node = node.child("kind")
-            if kind_node.value in kinds:
-                kind = ControllerKind(kind_node.value)
-            else:
-                kind = None
-                self.error(
-                    kind_node, f"expected {' or '.join(kinds)}, got {describe(kind_node.value)}"
-                )
-        if kind is ControllerKind.SERVO:
-            for key_node, _ in node.entries():
-                if key_node.value in CONTROLLER_KEYS and key_node.value not in SERVO_KEYS:
-                    self.error(
-                        key_node,
-                        f"{key_node.value!r} tunes the compliant controller only; the servo "
-                        f"reads {', '.join(SERVO_KEYS)}",
-                    )
-                    ok = False
-        length = self.units.length_factor
-        scale = {
-            "kp": 1.0,
-            "kp_angle": length * length / self.units.angle_factor,
-            "speed": length,
-            "force": length,
-            "torque": length * length,
-        }
-        values: dict[str, Any] = {}
-        for key, factor in scale.items():
-            if not node.has(key):
-                continue
-            child = node.child(key)
-            value = self.number(child, f"a positive {key}")
-            if value is None:
-                ok = False
-            elif value <= 0:
-                self.error(child, f"expected a positive {key}, got {fmt(value)}")
-                ok = False
-            else:
-                values[key] = value * factor
-        if kind is None or not ok:
-            return None
-        return Controller(kind=kind, **values)
-
-    def push_directions(self, node: Node) -> tuple[str, ...] | None:
-        items = self.list_of(node, f"a non-empty list drawn from {', '.join(PUSH_DIRECTIONS)}")
-        if items is None:
-            return None
-        chosen: list[str] = []
-        ok = True
-        for item in items:
-            if item.value not in PUSH_DIRECTIONS:
-                self.error(
-                    item,
-                    f"unknown push direction {describe(item.value)}; expected one "
-                    f"of {', '.join(repr(d) for d in PUSH_DIRECTIONS)} (quoted)",
-                )
-                ok = False
-            elif item.value in chosen:
-                self.error(
-                    item, f"push direction {item.value!r} is listed twice; list each at most once"
-                )
-                ok = False
-            else:
-                chosen.append(str(item.value))
-        return tuple(chosen) if ok else None

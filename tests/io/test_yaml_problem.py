@@ -1253,7 +1253,7 @@ def test_refuses_a_problem_of_more_polygon_vertices_than_the_cap(
 ) -> None:
     # The cap is 10,000; a file that big is slow to build, so the test lowers it to 7 and
     # gives two 4-vertex polygons: the second one passes the cap and is the one reported.
-    monkeypatch.setattr("arrange_up.io.yaml_builder.MAX_PROBLEM_VERTICES", 7)
+    monkeypatch.setattr("arrange_up.io.yaml_shapes.MAX_PROBLEM_VERTICES", 7)
     square = "{polygon: [[0, 0], [1, 0], [1, 1], [0, 1]]}"
     text = MINIMAL.replace("{box: [1, 1]}", square).replace(
         "    goal:", f"      B: {{kind: part, shape: {square.replace('0]', '0.0]')}}}\n    goal:"
