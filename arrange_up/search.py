@@ -48,9 +48,10 @@ Design choices (the contracts the planner relies on)
   computed. Open entries that become dominated by a later state are not removed.
 * **Infinite heuristic** values (``math.inf``) mark dead ends: the state is pruned and counted.
 * **Honest statuses.** ``NODE_LIMIT`` is returned the moment a node would be expanded beyond
-  ``max_nodes``, so ``UNSOLVABLE`` (open list exhausted) is never caused by the node limit. It
-  means "no plan exists *under the pruning in force*": states with infinite heuristic, edges with
-  no prediction and, when dominance is on, dominated states were not explored.
+  ``max_nodes``, so ``EXHAUSTED`` (open list ran empty) is never caused by the node limit. It
+  is not a proof that no plan exists: states with infinite heuristic, edges with no prediction
+  and, when dominance is on, dominated states were not explored. The search never returns
+  ``UNSOLVABLE``; that status is for callers that prove a problem unsolvable before searching.
 * **Tie-breaking.** The open list is ordered by ``(f, h)`` (greedy: ``(h, g)``), then a
   tie-breaker, then insertion order. With ``tie_break_seed=None`` the tie-breaker is constant, so
   ties among equal ``(f, h)`` are FIFO. With an integer seed it is a draw from
@@ -109,7 +110,11 @@ class SearchStatus(enum.StrEnum):
     NODE_LIMIT = "node-limit"
     #: The wall-clock ``timeout`` passed.
     TIMEOUT = "timeout"
-    #: The open list ran empty: no plan exists under the pruning in force.
+    #: The open list ran empty: no plan among the candidates the successors offered and the
+    #: pruning kept (not a proof that none exists).
+    EXHAUSTED = "exhausted"
+    #: Proven before any search: no plan exists (e.g. a goal part cannot fit on the table).
+    #: Plan files written before ``EXHAUSTED`` existed use it for exhausted searches too.
     UNSOLVABLE = "unsolvable"
     #: ``should_stop()`` returned True.
     CANCELLED = "cancelled"
@@ -217,7 +222,9 @@ class SearchResult(Generic[S, A]):
 
     ``plan``, ``states`` and ``cost`` are set if and only if ``status`` is ``SOLVED``; then
     ``states`` runs from the start to the goal state, ``len(states) == len(plan) + 1``, and
-    ``cost`` is the sum of the plan's edge costs.
+    ``cost`` is the sum of the plan's edge costs. ``best`` is an accepted state of the smallest
+    heuristic value (the first reached; ``stats.best_h`` is its value), None if none was
+    accepted: for an unsolved search, the state it came closest to the goal with.
     """
 
     status: SearchStatus
@@ -225,6 +232,7 @@ class SearchResult(Generic[S, A]):
     states: tuple[S, ...] | None
     cost: float | None
     stats: SearchStats
+    best: S | None = None
 
     def __post_init__(self) -> None:
         solved = self.status is SearchStatus.SOLVED
@@ -298,6 +306,7 @@ class _Search:
         self.rng = random.Random(tie_break_seed) if tie_break_seed is not None else None
 
         self.stats = SearchStats()
+        self.best: Any = None
         # Cheapest g each accepted state was reached with (the duplicate-detection table).
         self.g_best: dict[Any, float] = {}
         # States expanded at least once (value: g of the last expansion).
@@ -364,7 +373,9 @@ class _Search:
                 stats.pruned_infinite += 1
                 return None
             self.h_cache[state] = h
-        stats.best_h = min(stats.best_h, h)
+        if h < stats.best_h:
+            stats.best_h = h
+            self.best = state
         self.g_best[state] = g
         if bucket is not None:
             bucket[state] = g
@@ -474,14 +485,14 @@ class _Search:
             status = self.expand(node)
             if status is not None:
                 return self.finish(status)
-        return self.finish(SearchStatus.UNSOLVABLE)
+        return self.finish(SearchStatus.EXHAUSTED)
 
     def finish(self, status: SearchStatus, goal: _Node | None = None) -> SearchResult[Any, Any]:
         self.stats.elapsed = self.clock() - self.t0
         if self.progress is not None:
             self.progress(replace(self.stats))
         if goal is None:
-            return SearchResult(status, None, None, None, self.stats)
+            return SearchResult(status, None, None, None, self.stats, self.best)
         actions: list[Any] = []
         states: list[Any] = []
         node: _Node | None = goal
@@ -491,7 +502,7 @@ class _Search:
                 actions.append(node.action)
             node = node.parent
         return SearchResult(
-            status, tuple(reversed(actions)), tuple(reversed(states)), goal.g, self.stats
+            status, tuple(reversed(actions)), tuple(reversed(states)), goal.g, self.stats, self.best
         )
 
 
@@ -585,9 +596,9 @@ def best_first_search(
     -------
     SearchResult
         ``SOLVED`` with the plan, the states from start to goal and the cost; otherwise
-        ``NODE_LIMIT``, ``TIMEOUT``, ``CANCELLED`` or ``UNSOLVABLE`` (open list exhausted: no
-        plan exists under the pruning in force, i.e. ignoring states with infinite heuristic,
-        edges without prediction and dominated states). The statistics are exact; see
+        ``NODE_LIMIT``, ``TIMEOUT``, ``CANCELLED`` or ``EXHAUSTED`` (open list ran empty: no
+        plan among the states explored, which leave out states with infinite heuristic, edges
+        without prediction and dominated states; not a proof). The statistics are exact; see
         :class:`SearchStats`.
 
     Raises

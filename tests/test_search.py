@@ -155,7 +155,7 @@ def test_astar_is_optimal_on_random_grids(deferred: bool) -> None:
         reference = dijkstra(grid, start, goal)
         result = solve_grid(grid, start, goal, deferred=deferred, max_nodes=None)
         if reference is None:
-            assert result.status is SearchStatus.UNSOLVABLE
+            assert result.status is SearchStatus.EXHAUSTED
             assert result.plan is None and result.cost is None
             unsolvable += 1
         else:
@@ -315,7 +315,7 @@ def test_weighted_astar_returns_valid_bounded_plans(weight: float, deferred: boo
             max_nodes=None,
         )
         if reference is None:
-            assert result.status is SearchStatus.UNSOLVABLE
+            assert result.status is SearchStatus.EXHAUSTED
             continue
         assert_valid_plan(grid, start, goal, result)
         assert result.cost <= weight * reference + 1e-9
@@ -349,6 +349,7 @@ def test_statuses_are_strings_with_the_plan_files_values() -> None:
         "solved",
         "node-limit",
         "timeout",
+        "exhausted",
         "unsolvable",
         "cancelled",
     ]
@@ -393,13 +394,16 @@ def test_timeout_with_real_clock_and_slow_successors() -> None:
     assert time.monotonic() - t0 < 1.0
 
 
-def test_unreachable_goal_is_unsolvable() -> None:
+def test_unreachable_goal_is_exhausted_not_unsolvable() -> None:
     walls = frozenset({(4, 0), (5, 1)})  # seals off the corner (5, 0)
     grid = Grid(6, 4, walls)
     for deferred in (False, True):
         result = solve_grid(grid, (0, 0), (5, 0), deferred=deferred)
-        assert result.status is SearchStatus.UNSOLVABLE
+        assert result.status is SearchStatus.EXHAUSTED
         assert result.plan is None
+        # The closest state reached is reported: two steps from the sealed corner.
+        assert result.best in {(3, 0), (4, 1), (5, 2)}
+        assert result.stats.best_h == 2.0
     reachable = 6 * 4 - len(walls) - 1  # every free cell except (5, 0)
     eager = solve_grid(Grid(6, 4, walls), (0, 0), (5, 0))
     assert eager.stats.expanded == reachable
@@ -463,7 +467,7 @@ def test_infinite_heuristic_prunes(deferred: bool) -> None:
     assert all(n >= 0 for n in expanded)
 
     dead = best_first_search(-1, successors, lambda n: n == 5, h, deferred=deferred)
-    assert dead.status is SearchStatus.UNSOLVABLE
+    assert dead.status is SearchStatus.EXHAUSTED
     assert dead.stats.pruned_infinite == 1 and dead.stats.expanded == 0
 
 

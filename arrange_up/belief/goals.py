@@ -105,18 +105,23 @@ class GoalTest:
 
     def misses(self, state: WorldState) -> tuple[PartMiss, ...]:
         """Why ``state`` fails the goal, part by part (empty when it satisfies it)."""
-        names = state.names()
+        return self.misses_array(_as_array(state), state.names())
+
+    def misses_array(self, poses: np.ndarray, names: Sequence[str]) -> tuple[PartMiss, ...]:
+        """Why the particles ``poses`` (``(P, n, 3)``) fail the goal, part by part: a part's
+        excess in a dimension is the largest over the particles (empty when all satisfy it)."""
         missing = [p for p in self.parts if p not in names]
         if self.reference is not None and self.reference not in names:
             missing.append(self.reference)
         if missing:
             return tuple(PartMiss(p, True, (0.0, 0.0, 0.0)) for p in missing)
-        excess = self.excess(_as_array(state), names)
+        excess = self.excess(poses, names)
         assert excess is not None
+        worst = excess.max(axis=0)
         return tuple(
-            PartMiss(part, False, tuple(float(v) for v in excess[0, i]))  # type: ignore[arg-type]
+            PartMiss(part, False, tuple(float(v) for v in worst[i]))  # type: ignore[arg-type]
             for i, part in enumerate(self.parts)
-            if np.any(excess[0, i] > 0.0)
+            if np.any(worst[i] > 0.0)
         )
 
 

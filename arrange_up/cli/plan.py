@@ -124,8 +124,9 @@ def plan(
       arrange-up plan blocks-4 --particles 50 --seed 1 --output blocks-4.plan.json
       arrange-up plan my-problem.yaml --timeout 300 --json
 
-    Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted),
-    2 bad input.
+    Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted: the
+    candidates ran out, unsolvable: proven, e.g. a goal part larger than the table), 2 bad
+    input. An unsolved run prints one line of why.
     """
     check_semantics(semantics)
     loaded = load_problem(problem)
@@ -173,7 +174,7 @@ def plan(
         write_json_atomic(Path(output), document)
     if as_json:
         plan_length = len(result.actions) if result.actions is not None else None
-        echo_json(document_summary(document, output, plan_length=plan_length))
+        echo_json(document_summary(document, output, plan_length=plan_length, reason=result.reason))
     else:
         stats = result.stats
         click.echo(
@@ -183,6 +184,8 @@ def plan(
             f"generated {stats['generated']}, "
             f"transitions simulated {stats['transitions_simulated']}"
         )
+        if result.reason is not None:
+            click.echo(result.reason)
         if result.actions is not None:
             click.echo(actions_table(loaded, result.actions))
         if output:

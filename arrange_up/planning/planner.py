@@ -15,26 +15,33 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from arrange_up.belief.goals import PartMiss
+from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
-from arrange_up.search import SearchStats, SearchStatus, best_first_search
+from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_first_search
 
 __all__ = [
     "CANCELLED",
     "DEFAULT_MAX_NODES",
     "DEFAULT_WEIGHT",
+    "EXHAUSTED",
     "NODE_LIMIT",
     "SOLVED",
     "TIMEOUT",
     "UNSOLVABLE",
     "VARIETY_SPLIT",
+    "PartMiss",
     "PlanResult",
     "PlanStatistics",
     "ProgressCallback",
     "SearchSnapshot",
     "SearchStatus",
     "plan",
+    "too_large",
 ]
 
 #: The statuses of a planning run are those of the search (a string enum: ``"solved"``,
@@ -42,6 +49,7 @@ __all__ = [
 SOLVED = SearchStatus.SOLVED
 NODE_LIMIT = SearchStatus.NODE_LIMIT
 TIMEOUT = SearchStatus.TIMEOUT
+EXHAUSTED = SearchStatus.EXHAUSTED
 UNSOLVABLE = SearchStatus.UNSOLVABLE
 CANCELLED = SearchStatus.CANCELLED
 
@@ -109,6 +117,9 @@ class PlanResult:
     default) and ``beliefs`` (the predicted belief before the first action and after each
     action, for storyboards) are set iff ``status == "solved"``.
     ``statistics`` holds the search statistics; :attr:`stats` is their JSON form.
+    ``misses`` (None when solved) says how the belief of the smallest heuristic value the search
+    reached still misses the goal (per part, the dimensions some particle is out of tolerance
+    in); for ``unsolvable``, the parts that cannot fit on the table (``off table``).
     """
 
     status: SearchStatus
@@ -118,10 +129,38 @@ class PlanResult:
     particles: int
     statistics: PlanStatistics
     beliefs: tuple[Any, ...] | None = None
+    misses: tuple[PartMiss, ...] | None = None
 
     @property
     def solved(self) -> bool:
         return self.status == SearchStatus.SOLVED
+
+    @property
+    def reason(self) -> str | None:
+        """One line on why no plan was found (None when solved): the candidates refused by the
+        semantics (no prediction), pruned as dominated and by the ordering filter (an infinite
+        heuristic), and what the closest belief still misses."""
+        if self.solved:
+            return None
+        s = self.statistics
+        if self.status == SearchStatus.UNSOLVABLE:
+            parts = ", ".join(m.part for m in self.misses or ())
+            return f"{parts} cannot fit on the table in any orientation: no plan exists"
+        nodes = f"{s.expanded} node{'s' if s.expanded != 1 else ''}"
+        line = (
+            f"{self.status} after {nodes}: {s.no_prediction} candidates refused by the semantics "
+            f"(no prediction), {s.pruned_dominated} pruned as dominated, {s.pruned_infinite} by "
+            "the ordering filter"
+        )
+        if self.misses:
+            missed = ", ".join(
+                f"{m.part} (not on the table)"
+                if m.missing
+                else f"{m.part} in {' and '.join(m.dimensions())}"
+                for m in self.misses
+            )
+            line += f"; the best belief still misses {missed}"
+        return line
 
     @property
     def stats(self) -> dict[str, Any]:
@@ -234,21 +273,27 @@ def plan(
         if progress is not None:
             progress(SearchSnapshot.of(stats, task.semantics.simulations).to_json())
 
+    oversized = too_large(problem)
     try:
-        result = best_first_search(
-            task.initial_belief(),
-            task.successors,
-            task.is_goal,
-            task.heuristic,
-            weight=weight,
-            deferred=deferred,
-            dominance_index=task.dominance_index(),
-            max_nodes=limit,
-            timeout=None if timeout is None else max(0.0, timeout - (time.monotonic() - started)),
-            tie_break_seed=seed if tie_break else None,
-            progress=report,
-            should_stop=should_stop,
-        )
+        # A goal part that cannot fit on the table is a proof: no search is needed.
+        result = SearchResult(SearchStatus.UNSOLVABLE, None, None, None, SearchStats())
+        if not oversized:
+            result = best_first_search(
+                task.initial_belief(),
+                task.successors,
+                task.is_goal,
+                task.heuristic,
+                weight=weight,
+                deferred=deferred,
+                dominance_index=task.dominance_index(),
+                max_nodes=limit,
+                timeout=None
+                if timeout is None
+                else max(0.0, timeout - (time.monotonic() - started)),
+                tie_break_seed=seed if tie_break else None,
+                progress=report,
+                should_stop=should_stop,
+            )
     finally:
         task.close()
     statistics = PlanStatistics(
@@ -269,4 +314,45 @@ def plan(
         particles=task.semantics.particles,
         statistics=statistics,
         beliefs=tuple(result.states) if result.states is not None else None,
+        misses=_misses(task, result, oversized),
     )
+
+
+def _misses(
+    task: BeliefTask, result: SearchResult, oversized: tuple[str, ...]
+) -> tuple[PartMiss, ...] | None:
+    """:attr:`PlanResult.misses` of ``result``: the oversized parts (proven unsolvable), how the
+    best belief misses the goal, or None (solved, or no belief was accepted)."""
+    if oversized:
+        return tuple(PartMiss(p, True, (0.0, 0.0, 0.0)) for p in oversized)
+    if result.solved() or result.best is None:
+        return None
+    return task.goal.misses_array(result.best.poses, result.best.names())
+
+
+def too_large(problem: ArrangementProblem) -> tuple[str, ...]:
+    """The goal parts that cannot lie on the table in any orientation: a proof that no plan
+    exists, since every goal part must be on the table.
+
+    A part fits at some orientation only if its extent across that orientation's y axis is at
+    most the table's smaller side; its smallest extent over all directions (the width of its
+    convex hull, reached across one of the hull's edges) exceeding that side rules out every
+    orientation.
+    """
+    side = min(problem.table.width, problem.table.depth)
+    found = []
+    for name in problem.goal.parts:
+        shape = problem.object(name).shape
+        if shape is None:
+            continue
+        hull = footprint(shape.parts, (0.0, 0.0, 0.0)).convex_hull
+        points = np.asarray(hull.exterior.coords, dtype=float)[:-1]
+        if len(points) < 3:
+            continue
+        edges = np.roll(points, -1, axis=0) - points
+        normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        spans = points @ normals.T  # (vertex, edge direction)
+        if float((spans.max(axis=0) - spans.min(axis=0)).min()) > side + 1e-9:
+            found.append(name)
+    return tuple(found)

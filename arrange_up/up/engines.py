@@ -25,8 +25,11 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
   has no object of the exact name (PDDL names are case-insensitive), so such a plan is judged
   against ``to_up(load_pddl_problem(file))`` too; ``plan_from_up(plan, problem)`` names its
   actions' objects as ``problem`` does, for any other use.
-* ``UNSOLVABLE_INCOMPLETELY``: the node limit was reached, or the search space was exhausted
-  under pruning (the search is incomplete, so nothing is proven).
+* ``UNSOLVABLE_INCOMPLETELY``: the node limit was reached, or the search was exhausted (its
+  candidates ran out under the action generators and the pruning: nothing is proven); the log
+  message gives the planner's one line of why.
+* ``UNSOLVABLE_PROVEN``: proven before searching, e.g. a goal part that cannot fit on the
+  table.
 * ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
   watches the clock itself.
 * ``UNSUPPORTED_PROBLEM``: the problem is not an arrange-up problem; ``INTERNAL_ERROR``: the
@@ -487,14 +490,18 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
             return result(
                 Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
             )
-        if outcome.status == planner.UNSOLVABLE:
+        if outcome.status == planner.EXHAUSTED:
             message = (
-                "the search space was exhausted without a plan; the action generators and "
-                "dominance pruning make the search incomplete, so the problem is not proven "
-                "unsolvable"
+                f"{outcome.reason}; the action generators and dominance pruning make the search "
+                "incomplete, so the problem is not proven unsolvable"
             )
             return result(
                 Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
+            )
+        if outcome.status == planner.UNSOLVABLE:
+            message = str(outcome.reason)
+            return result(
+                Status.UNSOLVABLE_PROVEN, None, [LogMessage(LogLevel.INFO, message)], metrics
             )
         message = f"the planner stopped with status {str(outcome.status)!r}"
         return result(Status.INTERNAL_ERROR, None, [LogMessage(LogLevel.ERROR, message)], metrics)

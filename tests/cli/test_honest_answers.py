@@ -11,6 +11,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from catalogue import text
 from click.testing import CliRunner
 
 from arrange_up.cli import main
@@ -154,3 +155,43 @@ def test_a_plan_file_respects_the_umask(tmp_path):
         os.umask(previous)
     assert result.exit_code == 0, result.output
     assert stat.S_IMODE(output.stat().st_mode) == 0o640
+
+
+def test_an_exhausted_search_says_so_and_why_in_text_and_json(tmp_path):
+    path = tmp_path / "obstacle.yaml"
+    path.write_text(text("obstacle"))
+    args = ("plan", str(path), "--particles", "5", "--workers", "1")
+    shown = run(*args)
+    assert shown.exit_code == 1
+    status, why = shown.output.splitlines()
+    assert status.startswith("obstacle: exhausted (particles, 5 particles, seed 0)")
+    assert why.startswith("exhausted after 7 nodes: 0 candidates refused by the semantics")
+    assert why.endswith("by the ordering filter; the best belief still misses A in x")
+    assert "pruned as dominated" in why and "unsolvable" not in shown.output
+    summary = json.loads(run(*args, "--json", "-o", str(tmp_path / "p.json")).stdout)
+    assert summary["status"] == "exhausted" and summary["reason"] == why
+    assert json.loads((tmp_path / "p.json").read_text())["status"] == "exhausted"
+
+
+def test_a_goal_part_larger_than_the_table_is_unsolvable(tmp_path):
+    path = tmp_path / "big.yaml"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            name: big
+            table: {size: [3, 2]}
+            objects:
+              A: {kind: part, shape: {box: [4, 3]}}
+              paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+            goal:
+              tolerance: [0.2, 0.2, 15]
+              poses: {A: [1.5, 1, 0]}
+            """
+        )
+    )
+    shown = run("plan", str(path), "--semantics", "deterministic")
+    assert shown.exit_code == 1
+    assert "big: unsolvable (deterministic" in shown.output
+    assert "A cannot fit on the table in any orientation: no plan exists" in shown.output
+    summary = json.loads(run("plan", str(path), "--semantics", "deterministic", "--json").stdout)
+    assert summary["status"] == "unsolvable" and summary["plan_length"] is None

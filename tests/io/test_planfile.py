@@ -26,6 +26,7 @@ from arrange_up.io.planfile import (
 )
 from arrange_up.model.problem import problem_hash
 from arrange_up.model.world import Pick, Place, Push
+from arrange_up.search import SearchStatus
 
 #: A plan of block-and-fixture in internal units (inches, radians), one action of each kind.
 ACTIONS = (
@@ -226,6 +227,17 @@ def test_read_plan_errors_name_the_file_and_the_place(tmp_path, case):
     with pytest.raises(PlanFileError, match=message) as error:
         read_plan(path, problem)
     assert str(error.value).startswith(f"{path}: ")
+
+
+@pytest.mark.parametrize("status", ["exhausted", "unsolvable"])
+def test_an_unsolved_plan_file_old_or_new_reads_as_its_status(tmp_path, status):
+    # Files written before "exhausted" existed say "unsolvable" for an exhausted search: the
+    # status still parses, and reading the plan refuses it as any unsolved plan, by its status.
+    problem = tiny("block-and-fixture")
+    path = write(tmp_path, document(problem, None, status=status))
+    assert SearchStatus(json.loads(path.read_text())["status"]) == status
+    with pytest.raises(PlanFileError, match=f"status: the plan is '{status}', not 'solved'"):
+        read_plan(path, problem)
 
 
 def test_read_plan_of_a_missing_file_or_not_json(tmp_path):

@@ -6,10 +6,12 @@ import json
 
 import numpy as np
 import pytest
+from catalogue import tiny
 
 from arrange_up.belief.goals import GoalTest
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
+from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.world import Place, Push, nominal_initial_state, nominal_noise
 from arrange_up.physics.simulation import simulate
 from arrange_up.planning.planner import (
@@ -19,6 +21,7 @@ from arrange_up.planning.planner import (
     PlanStatistics,
     SearchSnapshot,
     plan,
+    too_large,
 )
 from arrange_up.planning.task import BeliefTask
 from arrange_up.search import SearchStatus
@@ -195,3 +198,62 @@ def test_plan_file_round_trip(tmp_path, blocks2):
         assert type(got) is type(want)
         if hasattr(want, "pose"):
             assert got.pose == pytest.approx(want.pose, abs=1e-9)
+
+
+# -- honest statuses: exhausted is not unsolvable --------------------------------------------------
+#: A 4 x 3 in part on a 3 x 2 in table: it fits in no orientation, whatever the goal tolerance
+#: (the loader only warns that at its goal pose it sticks out).
+TOO_LARGE = """
+name: too-large
+table: {size: [3, 2]}
+objects:
+  A: {kind: part, shape: {box: [4, 3]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+goal:
+  tolerance: [0.2, 0.2, 15]
+  poses: {A: [1.5, 1, 0]}
+"""
+
+
+def test_a_search_that_runs_out_of_candidates_is_exhausted_and_says_why():
+    result = plan(tiny("obstacle"), particles=5, workers=1)
+    assert result.status is SearchStatus.EXHAUSTED and result.status == "exhausted"
+    assert result.actions is None and result.stats["expanded"] == 7
+    # The best belief is the one of the smallest heuristic value: A still short of x = 5.
+    assert [(m.part, m.dimensions()) for m in result.misses] == [("A", ("x",))]
+    stats = result.statistics
+    assert result.reason == (
+        f"exhausted after 7 nodes: {stats.no_prediction} candidates refused by the semantics "
+        f"(no prediction), {stats.pruned_dominated} pruned as dominated, "
+        f"{stats.pruned_infinite} by the ordering filter; the best belief still misses A in x"
+    )
+    assert stats.pruned_dominated > 0
+
+
+def test_a_goal_part_larger_than_the_table_is_proven_unsolvable_before_searching():
+    problem, diagnostics = check_problem_text(TOO_LARGE, "too-large")
+    assert problem is not None and [d.severity for d in diagnostics] == ["warning"]
+    assert too_large(problem) == ("A",)
+    for semantics in ("deterministic", "particles"):
+        result = plan(problem, semantics=semantics, particles=5, workers=1)
+        assert result.status is SearchStatus.UNSOLVABLE and result.actions is None
+        assert result.stats["expanded"] == 0 and result.stats["transitions_simulated"] == 0
+        assert result.reason == "A cannot fit on the table in any orientation: no plan exists"
+    # Only the smallest width counts: turned a quarter, the part fits a 3 x 4 in table.
+    fits, _ = check_problem_text(TOO_LARGE.replace("[3, 2]", "[3, 4]"), "fits")
+    assert fits is not None and too_large(fits) == ()
+    assert too_large(tiny("obstacle")) == ()
+
+
+def test_a_solved_run_has_no_reason():
+    result = plan(tiny("obstacle"), semantics="deterministic")
+    assert result.solved and result.reason is None and result.misses is None
+
+
+def test_a_node_limit_says_which_parts_the_best_belief_has_not_placed(blocks2):
+    result = plan(blocks2, semantics="deterministic", max_nodes=1)
+    assert result.status is NODE_LIMIT
+    assert result.reason.startswith("node-limit after 1 node: ")
+    assert result.reason.endswith(
+        "the best belief still misses A (not on the table), B (not on the table)"
+    )

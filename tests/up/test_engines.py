@@ -12,6 +12,7 @@ from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from catalogue import tiny
 from unified_planning.engines import OptimalityGuarantee
 from unified_planning.engines import PlanGenerationResultStatus as Status
 from unified_planning.engines.results import ValidationResultStatus
@@ -24,6 +25,7 @@ import arrange_up.up.engines as engines
 import arrange_up.up.registration as registration
 from arrange_up.io.domains import domains_dir, load
 from arrange_up.io.pddl import domain_path
+from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.up.compile import from_up, to_up
 
 engines.register()  # idempotent; works before or after unified_planning is imported
@@ -319,3 +321,25 @@ def test_a_plan_solved_from_pddl_is_validated_against_the_file_as_arrange_up_loa
     with PlanValidator(name="sequential_plan_validator") as validator:
         check = validator.validate(compiled, plan_to_up(compiled, actions))
     assert check.status is ValidationResultStatus.VALID
+
+
+def test_an_exhausted_search_is_incomplete_and_a_too_large_part_proven_unsolvable():
+    exhausted = _solve(
+        to_up(tiny("obstacle")), {"semantics": "particles", "particles": 5, "seed": 0}
+    )
+    assert exhausted.status is Status.UNSOLVABLE_INCOMPLETELY and exhausted.plan is None
+    assert exhausted.metrics["status"] == "exhausted"
+    message = exhausted.log_messages[0].message
+    assert message.startswith("exhausted after 7 nodes: ") and "not proven unsolvable" in message
+    big, _ = check_problem_text(
+        "name: big\ntable: {size: [3, 2]}\nobjects:\n  A: {kind: part, shape: {box: [4, 3]}}\n"
+        "  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}\n"
+        "goal: {tolerance: [0.2, 0.2, 15], poses: {A: [1.5, 1, 0]}}\n",
+        "big",
+    )
+    assert big is not None
+    proven = _solve(to_up(big))
+    assert proven.status is Status.UNSOLVABLE_PROVEN and proven.plan is None
+    assert proven.log_messages[0].message == (
+        "A cannot fit on the table in any orientation: no plan exists"
+    )
