@@ -21,13 +21,9 @@ from pathlib import Path
 from typing import IO, Any
 
 from arrange_up.evaluation.outcomes import FAILURE_KINDS, GOAL_MISSED, RolloutRecord
+from arrange_up.io.files import lock_exclusively
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Pick, Place, Push
-
-try:
-    import fcntl
-except ImportError:  # pragma: no cover - not on POSIX: files are not locked
-    fcntl = None
 
 __all__ = ["RECORD_FORMAT", "RecordFile", "RecordFileError", "plan_hash", "record_header"]
 
@@ -171,14 +167,8 @@ class RecordFile:
             raise
 
     def _lock(self) -> None:
-        if fcntl is None:  # pragma: no cover - not on POSIX
-            return
-        try:
-            fcntl.flock(self.handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise RecordFileError(
-                f"{self.path}: the record file is in use by another evaluation"
-            ) from None
+        if not lock_exclusively(self.handle):
+            raise RecordFileError(f"{self.path}: the record file is in use by another evaluation")
 
     def _read(self, header: dict) -> dict[int, RolloutRecord]:
         handle = self.handle

@@ -27,10 +27,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
 
-try:
-    import fcntl
-except ImportError:  # pragma: no cover - not on POSIX: files are not locked
-    fcntl = None
+from arrange_up.io.files import lock_exclusively
 
 __all__ = [
     "CsvAppender",
@@ -113,15 +110,11 @@ class CsvAppender:
         return self
 
     def _lock(self) -> None:
-        if fcntl is None:  # pragma: no cover - not on POSIX
-            return
-        try:
-            fcntl.flock(self.handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
+        if not lock_exclusively(self.handle):
             raise CsvRecordsError(
                 f"{self.path}: the CSV is in use by another run of the experiment; wait for it "
                 "or write to another output directory"
-            ) from None
+            )
 
     def _open(self) -> None:
         self.handle.seek(0)

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.io import validation
+from arrange_up.io.files import undecodable_place
 from arrange_up.io.pddl_domain import (
     ANGLE_FUNCTIONS,
     DOMAIN_FILE,
@@ -92,9 +93,7 @@ def check_pddl_problem(path: str | Path, domain: str | Path | None = None) -> Ch
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
-        before = data[: error.start]
-        line = before.count(b"\n") + 1
-        column = len(before) - (before.rfind(b"\n") + 1) + 1
+        line, column = undecodable_place(data, error)
         message = (
             f"not a text file: byte 0x{data[error.start]:02x} is not UTF-8; expected a PDDL "
             "problem file in UTF-8"

@@ -36,6 +36,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from arrange_up.io.files import undecodable_place
 from arrange_up.io.validation import angle_problem
 from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import (
@@ -225,9 +226,7 @@ def _read_document(path: Path) -> Any:
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
-        before = data[: error.start]
-        line = before.count(b"\n") + 1
-        column = len(before) - (before.rfind(b"\n") + 1) + 1
+        line, column = undecodable_place(data, error)
         raise PlanFileError(
             f"{path}:{line}:{column}: not a text file: byte 0x{data[error.start]:02x} is not "
             "UTF-8; expected a plan file (JSON in UTF-8)"

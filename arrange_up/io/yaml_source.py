@@ -26,6 +26,7 @@ from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
 from ruamel.yaml.reader import ReaderError
 from ruamel.yaml.scalarbool import ScalarBoolean
 
+from arrange_up.io.files import undecodable_place
 from arrange_up.io.validation import angle_problem
 from arrange_up.model.errors import Diagnostic
 from arrange_up.model.problem import Pose
@@ -69,9 +70,7 @@ def read_text(path: Path, source: str) -> tuple[str | None, Diagnostic | None]:
     try:
         return data.decode("utf-8-sig"), None
     except UnicodeDecodeError as error:
-        before = data[: error.start]
-        line = before.count(b"\n") + 1
-        column = len(before) - (before.rfind(b"\n") + 1) + 1
+        line, column = undecodable_place(data, error)
         return None, fail(
             f"not a text file: byte 0x{data[error.start]:02x} is not UTF-8; expected a YAML "
             "problem file in UTF-8",
