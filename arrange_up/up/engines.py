@@ -95,6 +95,7 @@ environment's ``up.ini`` (:mod:`arrange_up.up.__main__`).
 from __future__ import annotations
 
 import difflib
+import functools
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -127,8 +128,9 @@ from arrange_up.evaluation.outcomes import GOAL_MISSED
 from arrange_up.evaluation.reliability import EvaluationProgress
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Place, Push
+from arrange_up.parallel import BACKENDS
 from arrange_up.planning import planner
-from arrange_up.repair import TIMEOUT, repair_plan
+from arrange_up.repair import METHODS, TIMEOUT, repair_plan
 from arrange_up.transitions import available
 from arrange_up.transitions.particles import DeterministicSemantics
 from arrange_up.up.compile import (
@@ -246,6 +248,16 @@ class _ArrangeUpEngine(Engine):
         )
 
 
+class _Satisficing:
+    """For the engines that return plans: satisficing only; no plan is claimed optimal (the
+    planner runs weighted A* with an incomplete action generator, the repairer scores
+    candidates on a sample)."""
+
+    @staticmethod
+    def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
+        return optimality_guarantee is OptimalityGuarantee.SATISFICING
+
+
 @dataclass(frozen=True)
 class _Refusal:
     """Why a problem or plan cannot be read: ``internal`` False when it is not arrange-up's,
@@ -351,7 +363,7 @@ def _describe(action: Action) -> str:
 # ---------------------------------------------------------------------------------------------
 # the planner
 # ---------------------------------------------------------------------------------------------
-class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
+class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
     """Conformant belief-space planning for arrange-up problems (see the module doc)."""
 
     _NAME = ENGINE_NAME
@@ -375,11 +387,6 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
         self._seed = seed
         self._max_nodes = max_nodes
         self._model = model
-
-    @staticmethod
-    def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
-        """Satisficing only: the plans are not claimed optimal (weighted A*, incomplete)."""
-        return optimality_guarantee is OptimalityGuarantee.SATISFICING
 
     def _solve_with_params(
         self,
@@ -418,15 +425,7 @@ class ArrangeUpPlanner(_ArrangeUpEngine, OneshotPlannerMixin):
             )
         stream = output_stream
 
-        def result(
-            status: Status,
-            plan: Plan | None = None,
-            logs: Sequence[LogMessage] = (),
-            metrics: dict[str, str] | None = None,
-        ) -> PlanGenerationResult:
-            return PlanGenerationResult(
-                status, plan, ENGINE_NAME, metrics=metrics, log_messages=list(logs) or None
-            )
+        result = functools.partial(_generation_result, ENGINE_NAME)
 
         arrangement = _read_problem(problem)
         if isinstance(arrangement, _Refusal):
@@ -512,13 +511,11 @@ def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any, mod
         raise ValueError(
             f"arrange-up: unknown semantics {semantics!r}; expected one of {', '.join(available())}"
         )
-    if not isinstance(particles, int) or isinstance(particles, bool) or particles < 1:
+    if not _positive(particles):
         raise ValueError(f"arrange-up: particles must be a positive integer, got {particles!r}")
     if not isinstance(seed, int) or isinstance(seed, bool):
         raise ValueError(f"arrange-up: seed must be an integer, got {seed!r}")
-    if max_nodes is not None and (
-        not isinstance(max_nodes, int) or isinstance(max_nodes, bool) or max_nodes < 1
-    ):
+    if max_nodes is not None and not _positive(max_nodes):
         raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
     if model is not None:
         if semantics != "cbst":
@@ -602,6 +599,19 @@ def _check_timeout(engine: str, timeout: Any) -> None:
 
 class _OutOfTime(Exception):
     """Raised from an evaluation's progress callback when the validator's timeout ran out."""
+
+
+def _generation_result(
+    engine: str,
+    status: Status,
+    plan: Plan | None = None,
+    logs: Sequence[LogMessage] = (),
+    metrics: dict[str, str] | None = None,
+) -> PlanGenerationResult:
+    """The planner's or the repairer's answer, named ``engine`` (no log list when empty)."""
+    return PlanGenerationResult(
+        status, plan, engine, metrics=metrics, log_messages=list(logs) or None
+    )
 
 
 def _positive(value: Any) -> bool:
@@ -764,8 +774,9 @@ def _check_validator_params(
         raise ValueError(f"{VALIDATOR_NAME}: seed must be a non-negative integer, got {seed!r}")
     if workers is not None and not _positive(workers):
         raise ValueError(f"{VALIDATOR_NAME}: workers must be a positive integer, got {workers!r}")
-    if backend not in ("local", "dask"):
-        raise ValueError(f"{VALIDATOR_NAME}: backend must be 'local' or 'dask', got {backend!r}")
+    if backend not in BACKENDS:
+        expected = " or ".join(repr(b) for b in BACKENDS)
+        raise ValueError(f"{VALIDATOR_NAME}: backend must be {expected}, got {backend!r}")
     if scheduler is not None and (backend != "dask" or not isinstance(scheduler, str)):
         raise ValueError(f"{VALIDATOR_NAME}: a scheduler address needs backend='dask'")
 
@@ -773,7 +784,7 @@ def _check_validator_params(
 # ---------------------------------------------------------------------------------------------
 # the fixture-placement plan repairer
 # ---------------------------------------------------------------------------------------------
-class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
+class ArrangeUpFixtureRepairer(_Satisficing, _ArrangeUpEngine, PlanRepairerMixin):
     """Fixture-placement plan repair (thesis ch. 4,
     :func:`arrange_up.repair.repair_plan`):
     ``PlanRepairer(name="arrange-up-fixtures", params={...}).repair(problem, plan)``.
@@ -823,23 +834,10 @@ class ArrangeUpFixtureRepairer(_ArrangeUpEngine, PlanRepairerMixin):
         self._workers = workers
         self._timeout = timeout
 
-    @staticmethod
-    def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
-        """Satisficing only: the repaired plans are not claimed optimal."""
-        return optimality_guarantee is OptimalityGuarantee.SATISFICING
-
     def _repair(self, problem: AbstractProblem, plan: Plan) -> PlanGenerationResult:
         started = time.monotonic()
 
-        def result(
-            status: Status,
-            plan: Plan | None = None,
-            logs: Sequence[LogMessage] = (),
-            metrics: dict[str, str] | None = None,
-        ) -> PlanGenerationResult:
-            return PlanGenerationResult(
-                status, plan, REPAIRER_NAME, metrics=metrics, log_messages=list(logs) or None
-            )
+        result = functools.partial(_generation_result, REPAIRER_NAME)
 
         def refuse(
             message: str, status: Status = Status.UNSUPPORTED_PROBLEM
@@ -939,7 +937,8 @@ def _check_repairer_params(particles: Any, seed: Any, method: Any, workers: Any)
         )
     if not isinstance(seed, int) or isinstance(seed, bool):
         raise ValueError(f"{REPAIRER_NAME}: seed must be an integer, got {seed!r}")
-    if method not in ("naive", "enhanced"):
-        raise ValueError(f"{REPAIRER_NAME}: method must be 'naive' or 'enhanced', got {method!r}")
+    if method not in METHODS:
+        expected = " or ".join(repr(m) for m in METHODS)
+        raise ValueError(f"{REPAIRER_NAME}: method must be {expected}, got {method!r}")
     if not _positive(workers):
         raise ValueError(f"{REPAIRER_NAME}: workers must be a positive integer, got {workers!r}")
