@@ -30,7 +30,10 @@ Distances:
 * to the wall ahead (the controller stalls when the train of parts is compressed against it),
   generated only when the goal holds the part against that wall, directly or through a train
   of touching goal parts that are all on the table already — never towards an edge without a
-  wall, where it would only push parts off;
+  wall, where it would only push parts off; under the compliant controller not once the part
+  and that train all lie within their goal intervals along the push (pressing them into the
+  wall again only perturbs them, a new belief each time, a plateau without end; under the
+  servo the repeat is a no-op the search prunes as a duplicate);
 * to the part's goal coordinate along the direction, when that lies ahead;
 * each of ``planning.push_distances`` (how far the part should travel).
 
@@ -122,6 +125,7 @@ class ActionGenerator:
         self.place_unc = problem.uncertainty.place
         self.push_unc = problem.uncertainty.push
         self.manipulators = tuple(_describe(spec) for spec in problem.manipulators)
+        self.compliant = problem.controller.kind is ControllerKind.COMPLIANT
         self.stall_per_area = _stall_per_area(problem)
         self.areas = {spec.name: spec.shape.area for spec in problem.parts}
         self.wall_trains = self._wall_trains()
@@ -391,6 +395,7 @@ class ActionGenerator:
             wall in self.problem.table.walls
             and train is not None
             and all(q in belief for q in train)
+            and not (self.compliant and self._settled((name, *train), belief, axis))
         ):
             boundary = size if sign > 0 else 0.0
             candidates.append(sign * boundary - front)
@@ -408,6 +413,19 @@ class ActionGenerator:
             if d > gap + MIN_PUSH and all(abs(d - r) > DISTANCE_RESOLUTION for r, _ in result):
                 result.append((d, travels[d]))
         return result
+
+    def _settled(self, parts: tuple[str, ...], belief: IntervalBelief, axis: int) -> bool:
+        """Whether every one of ``parts`` lies within its goal interval along ``axis`` in every
+        state of ``belief`` (its interval inside the target +- the tolerance)."""
+        tolerance = self.problem.goal.tolerance[axis] + 1e-9
+        for part in parts:
+            target = self.place_target(part, belief)
+            interval = belief.get(part)
+            if target is None or interval is None:
+                return False
+            if abs(interval.center[axis] - target[axis]) + interval.half[axis] > tolerance:
+                return False
+        return True
 
     def _solve_distance(
         self, push: Push, name: str, axis: int, sign: int, travel: float, belief: IntervalBelief

@@ -13,7 +13,10 @@ particle beliefs (§3.1): an interval is inside the goal interval iff every part
   wrong order, so that no sequence of pushes can reorder them, or when a goal part still off
   the table can never be placed: each of its place candidates overlaps both the current shadow
   and the goal footprint of some part on the table (parts placed out of order have walled it
-  in; the planner only moves parts towards their goals, so the overlap stays); else 0.
+  in; the planner only moves parts towards their goals, so the overlap stays), or two goal
+  parts still off the table can be placed in neither order (each placed first, at any of its
+  open candidates, walls in every open candidate of the other by the same rule: the cells of a
+  corner pocket, which must be filled from the walls outwards); else 0.
 * ``admissible``: ``ordering`` plus one per goal part not yet on the table (each needs at least
   one place action). Still admissible, and a little better informed than the bare filter.
 * ``inadmissible``: §3.2's per-dimension count: per goal part 2 if it is off the table, 2 if
@@ -157,6 +160,8 @@ class _OrderingFilter:
         self.goal_parts = goal.parts
         self.targets = {p: tuple(goal.targets[k]) for k, p in enumerate(goal.parts)}
         self.pairs: list[tuple[str, str, int]] = []  # (a, b, axis): goal has a before b on axis
+        self._place_cache: dict[str, list] = {}
+        self._pairs_blocking = None
         if goal.reference is not None:
             return
         boxes = {
@@ -182,30 +187,85 @@ class _OrderingFilter:
         intervals = belief.intervals
         if self.generator is not None and len(intervals.objects) < len(self.goal_parts):
             placed = [(q, iv) for q, iv in intervals.objects if q in self.targets]
+            alive: dict[str, list[int]] = {}
             for part in self.goal_parts:
-                if part not in intervals and self._walled_in(part, intervals, placed):
-                    return True
+                if part not in intervals:
+                    alive[part] = self._open_candidates(part, intervals, placed)
+                    if not alive[part]:
+                        return True
+            if self._no_place_order(alive, intervals):
+                return True
         return self._row_order_violated(intervals)
 
-    def _walled_in(self, part: str, intervals, placed) -> bool:
-        """True if every place candidate of ``part`` is blocked for good.
+    def _open_candidates(self, part: str, intervals, placed) -> list[int]:
+        """The indices of ``part``'s place candidates that are not blocked for good.
 
         A candidate is blocked for good by a goal part ``q`` on the table when it overlaps both
         ``q``'s current shadow and ``q``'s goal footprint: the planner only ever moves ``q``
         towards its goal, and between two overlapping positions ``q`` keeps overlapping.
         """
-        assert self.generator is not None
         half = self.generator.place_unc
         none = (0.0, 0.0, 0.0)
-        for pose in self.generator.place_poses(intervals, part):
+        found = []
+        for k, pose in enumerate(self._candidates(part, intervals)):
             candidate = (part, pose, half)
             if not any(
                 self.checker.shadows_overlap(candidate, (q, iv.center, iv.half))
                 and self.checker.shadows_overlap(candidate, (q, self.targets[q], none))
                 for q, iv in placed
             ):
-                return False
-        return True
+                found.append(k)
+        return found
+
+    def _candidates(self, part: str, intervals) -> list:
+        """``part``'s place candidates; for an absolute goal they never change, so cached."""
+        if part not in self._place_cache:
+            self._place_cache[part] = self.generator.place_poses(intervals, part)
+        return self._place_cache[part]
+
+    def _no_place_order(self, alive: dict[str, list[int]], intervals) -> bool:
+        """True if two goal parts off the table can be placed in neither order.
+
+        ``q`` can follow ``p`` when some open candidate of ``q`` is not blocked for good by
+        ``p`` placed at one of its open candidates (the same rule as for parts on the table,
+        with ``p`` anywhere between that candidate and its goal). Only pairs whose candidate
+        shadows can reach each other's goal footprints are checked (:meth:`_pair_blocking`).
+        """
+        for (p, q), blocked in self._pair_blocking(intervals).items():
+            if p not in alive or q not in alive:
+                continue
+            p_then_q = any(not blocked[0][i][j] for i in alive[p] for j in alive[q])
+            q_then_p = any(not blocked[1][j][i] for i in alive[p] for j in alive[q])
+            if not p_then_q and not q_then_p:
+                return True
+        return False
+
+    def _pair_blocking(self, intervals):
+        """For each unordered pair ``(p, q)`` of goal parts: ``(after_p, after_q)`` where
+        ``after_p[i][j]`` says whether ``q``'s candidate ``j`` is blocked for good by ``p`` at
+        its candidate ``i``, and ``after_q[j][i]`` the reverse; pairs where nothing is blocked
+        are left out. Computed once (absolute goals: the candidates are fixed)."""
+        if self._pairs_blocking is not None:
+            return self._pairs_blocking
+        half = self.generator.place_unc
+        none = (0.0, 0.0, 0.0)
+        poses = {p: self._candidates(p, intervals) for p in self.goal_parts}
+
+        def blocked(a: str, pa, b: str, pb) -> bool:
+            candidate = (b, pb, half)
+            return self.checker.shadows_overlap(
+                candidate, (a, pa, half)
+            ) and self.checker.shadows_overlap(candidate, (a, self.targets[a], none))
+
+        table = {}
+        for i, p in enumerate(self.goal_parts):
+            for q in self.goal_parts[i + 1 :]:
+                after_p = [[blocked(p, pa, q, pb) for pb in poses[q]] for pa in poses[p]]
+                after_q = [[blocked(q, pb, p, pa) for pa in poses[p]] for pb in poses[q]]
+                if any(any(row) for row in after_p) or any(any(row) for row in after_q):
+                    table[(p, q)] = (after_p, after_q)
+        self._pairs_blocking = table
+        return table
 
     def _row_order_violated(self, intervals) -> bool:
         for a, b, axis in self.pairs:

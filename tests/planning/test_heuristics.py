@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from catalogue import tiny, with_planning
 
+import arrange_up
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import AngleFrame, ParticleBelief
 from arrange_up.geometry.collision import CollisionChecker
@@ -220,3 +221,20 @@ def test_a_part_walled_in_by_a_part_placed_out_of_order_is_infinite(tight_offset
     # Without the planner's action generator this part of the filter is off.
     unaware = heuristic("ordering", tight_offsets, with_generator=False)
     assert unaware(particles(tight_offsets, 0.02, A=(9.5, 0.5, 0.0))) == 0.0
+
+
+def test_two_parts_off_the_table_that_fit_in_neither_order_are_infinite():
+    # blocks-9-square with its third column (C, F, I) and top row (G, H) built: the corner
+    # pocket A, B, D, E is closed. A placed first walls in B (B's only open candidates reach A's
+    # goal cell), B placed first walls in A, and likewise for the other pairs.
+    problem = arrange_up.load("blocks-9-square")
+    h = heuristic("ordering", problem)
+    built = {p: problem.goal.target(p) for p in "CFGHI"}
+    assert h(particles(problem, 0.01, **built)) == math.inf
+    # Built from the corner outwards (the bottom row first), every pair still has an order.
+    row = {p: problem.goal.target(p) for p in "ABC"}
+    assert h(particles(problem, 0.01, **row)) == 0.0
+    # C built before B closes B's cell: B between A's goal and C fits in neither order with A.
+    assert h(particles(problem, 0.01, C=row["C"])) == math.inf
+    # The empty table: the corner is filled from the walls outwards.
+    assert h(ParticleBelief((WorldState.from_mapping(problem, {}),))) == 0.0
