@@ -14,10 +14,11 @@ Problems are frozen dataclasses, so one loaded problem is shared by every test t
 
 from __future__ import annotations
 
+import dataclasses
 from functools import cache
 
 from arrange_up.io.yaml_problem import check_problem_text
-from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.problem import SERVO_CONTROLLER, ArrangementProblem
 
 TEXTS: dict[str, str] = {
     # One block to the lower-right corner of a small walled board; starts off the table.
@@ -158,6 +159,12 @@ def with_planning(name: str, hints: str) -> ArrangementProblem:
     """Catalogue entry ``name`` with the ``planning:`` hints ``hints`` (a YAML flow mapping,
     e.g. ``'{push_distances: [0.5]}'``); no entry has hints of its own."""
     return _load(f"{text(name)}planning: {hints}\n", f"catalogue:{name}+planning")
+
+
+def servo(problem: ArrangementProblem) -> ArrangementProblem:
+    """``problem`` driven by the servo: for tests of rules stated for a push that ends where it
+    was sent (the default compliant controller stops short: tests/planning/test_stall_aware.py)."""
+    return dataclasses.replace(problem, controller=SERVO_CONTROLLER)
 
 
 def _load(yaml_text: str, source: str) -> ArrangementProblem:

@@ -1,9 +1,13 @@
 """Golden outputs that pin the planner's, the evaluator's and the repair's behaviour.
 
 Each case is a function of no arguments returning plain JSON data (every float written at full
-precision, wall times left out). ``tests/test_golden.py`` recomputes every case and compares it
-with ``tests/goldens/<case>.json``, bit for bit. A change that alters behaviour on purpose
-regenerates them in the commit that makes it, saying why in the commit message::
+precision, wall times left out). The cases run every problem under its own controller (the
+compliant one, the default, for every shipped problem) and, as the ``servo-`` cases, under the
+servo: those pin the behaviour that was the default before the compliant controller was, and
+that a problem keeps choosing with ``controller: {kind: servo}``. ``tests/test_golden.py``
+recomputes every case and compares it with ``tests/goldens/<case>.json``, bit for bit. A
+change that alters behaviour on purpose regenerates them in the commit that makes it, saying
+why in the commit message::
 
     python tests/golden.py              # rewrite every golden file
     python tests/golden.py blocks-2-p10-s0  # rewrite one
@@ -21,6 +25,7 @@ from typing import Any
 
 import arrange_up
 from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.model.problem import SERVO_CONTROLLER
 from arrange_up.repair import repair_plan
 
 GOLDEN_DIR = Path(__file__).parent / "goldens"
@@ -48,10 +53,18 @@ def plain(value: Any) -> Any:
     return value
 
 
-def _plan_case(name: str, semantics: str, particles: int, seed: int) -> Callable[[], Any]:
+def _load(name: str, servo: bool):
+    """The shipped problem ``name``, driven by the servo if ``servo``."""
+    problem = arrange_up.load(name)
+    return dataclasses.replace(problem, controller=SERVO_CONTROLLER) if servo else problem
+
+
+def _plan_case(
+    name: str, semantics: str, particles: int, seed: int, servo: bool
+) -> Callable[[], Any]:
     def case() -> Any:
         result = arrange_up.plan(
-            arrange_up.load(name), semantics=semantics, particles=particles, seed=seed
+            _load(name, servo), semantics=semantics, particles=particles, seed=seed
         )
         return {
             "status": plain(result.status),
@@ -64,9 +77,11 @@ def _plan_case(name: str, semantics: str, particles: int, seed: int) -> Callable
     return case
 
 
-def _evaluation_case(name: str, semantics: str, particles: int, seed: int) -> Callable[[], Any]:
+def _evaluation_case(
+    name: str, semantics: str, particles: int, seed: int, servo: bool
+) -> Callable[[], Any]:
     def case() -> Any:
-        problem = arrange_up.load(name)
+        problem = _load(name, servo)
         result = arrange_up.plan(problem, semantics=semantics, particles=particles, seed=seed)
         reliability = evaluate_plan(problem, result.actions, rollouts=200, seed=0, workers=1)
         data = plain(reliability.to_json())
@@ -77,9 +92,9 @@ def _evaluation_case(name: str, semantics: str, particles: int, seed: int) -> Ca
     return case
 
 
-def _repair_case(name: str, particles: int) -> Callable[[], Any]:
+def _repair_case(name: str, particles: int, servo: bool) -> Callable[[], Any]:
     def case() -> Any:
-        problem = arrange_up.load(name)
+        problem = _load(name, servo)
         nominal = arrange_up.plan(problem, semantics="deterministic")
         result = repair_plan(problem, nominal.actions, particles=particles, seed=0, workers=1)
         return {
@@ -97,20 +112,28 @@ SHIPPED = [
 ]  # fmt: skip
 
 CASES: dict[str, Callable[[], Any]] = {}
-for _name in SHIPPED:
-    CASES[f"{_name}-deterministic"] = _plan_case(_name, "deterministic", 1, 0)
-for _name in ("blocks-2", "blocks-3", "blocks-4"):
-    for _particles in (10, 25):
-        for _seed in (0, 1):
-            CASES[f"{_name}-p{_particles}-s{_seed}"] = _plan_case(
-                _name, "particles", _particles, _seed
-            )
-for _name in ("blocks-2", "blocks-3", "blocks-4", "blocks-7"):
-    CASES[f"{_name}-cbst"] = _plan_case(_name, "cbst", 1, 0)
-CASES["evaluate-blocks-3-deterministic"] = _evaluation_case("blocks-3", "deterministic", 1, 0)
-CASES["evaluate-blocks-4-p10-s0"] = _evaluation_case("blocks-4", "particles", 10, 0)
-CASES["evaluate-blocks-4-cbst"] = _evaluation_case("blocks-4", "cbst", 1, 0)
-CASES["repair-tz-mating-p10"] = _repair_case("tz-mating", 10)
+for _servo, _prefix in ((False, ""), (True, "servo-")):
+    for _name in SHIPPED:
+        CASES[f"{_prefix}{_name}-deterministic"] = _plan_case(_name, "deterministic", 1, 0, _servo)
+    for _name in ("blocks-2", "blocks-3", "blocks-4"):
+        for _particles in (10, 25):
+            for _seed in (0, 1):
+                CASES[f"{_prefix}{_name}-p{_particles}-s{_seed}"] = _plan_case(
+                    _name, "particles", _particles, _seed, _servo
+                )
+    for _name in ("blocks-2", "blocks-3", "blocks-4", "blocks-7") if _servo else ():
+        CASES[f"{_prefix}{_name}-cbst"] = _plan_case(_name, "cbst", 1, 0, _servo)
+    CASES[f"{_prefix}evaluate-blocks-3-deterministic"] = _evaluation_case(
+        "blocks-3", "deterministic", 1, 0, _servo
+    )
+    CASES[f"{_prefix}evaluate-blocks-4-p10-s0"] = _evaluation_case(
+        "blocks-4", "particles", 10, 0, _servo
+    )
+    if _servo:
+        CASES[f"{_prefix}evaluate-blocks-4-cbst"] = _evaluation_case(
+            "blocks-4", "cbst", 1, 0, _servo
+        )
+    CASES[f"{_prefix}repair-tz-mating-p10"] = _repair_case("tz-mating", 10, _servo)
 
 
 def golden_path(case: str) -> Path:

@@ -22,7 +22,7 @@ from arrange_up.io.pddl_domain import (
     number_term,
 )
 from arrange_up.io.shape_catalogue import PDDL_NAME, Catalogue, load_catalogue
-from arrange_up.model.problem import ArrangementProblem, PlanningHints
+from arrange_up.model.problem import DEFAULT_CONTROLLER, ArrangementProblem, PlanningHints
 
 __all__ = ["PddlExportError", "write_pddl_problem"]
 
@@ -103,6 +103,12 @@ def write_pddl_problem(problem: ArrangementProblem, catalogue: Catalogue | None 
         reasons.append(
             f"planning hints ({', '.join('planning.' + u for u in used)}): PDDL has no place "
             "for them"
+        )
+    if problem.controller != DEFAULT_CONTROLLER:
+        reasons.append(
+            f"the push controller (controller: kind {problem.controller.kind.value}, or gains "
+            "other than the defaults): PDDL has no place for it, and a PDDL problem is driven by "
+            "the default compliant controller"
         )
     goal = problem.goal
     if goal.tolerance[2] is None and any(pose[2] != 0 for _, pose in goal.targets):

@@ -23,7 +23,8 @@ the plan complete, only when ``status`` is ``"solved"``; any other status record
 failure with its search statistics. ``hash`` identifies the problem's content (see
 :func:`arrange_up.model.problem.problem_hash`); the commands that read plans warn when it does not
 match the problem they are given (:func:`plan_problem_mismatch`). ``controller`` is the problem's
-push controller (:func:`controller_to_json`), present when it is not the default one.
+push controller (:func:`controller_to_json`); a file without one was made before plan files
+recorded it, when every problem was driven by the servo.
 """
 
 from __future__ import annotations
@@ -38,10 +39,11 @@ from typing import Any
 
 from arrange_up.io.files import undecodable_place
 from arrange_up.io.validation import angle_problem
+from arrange_up.io.yaml_settings import SERVO_KEYS
 from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import (
-    DEFAULT_CONTROLLER,
     ArrangementProblem,
+    ControllerKind,
     ObjectKind,
     problem_hash,
 )
@@ -149,8 +151,7 @@ def plan_document(
         "semantics": semantics,
         "seed": seed,
     }
-    if problem.controller != DEFAULT_CONTROLLER:
-        doc["controller"] = controller_to_json(problem)
+    doc["controller"] = controller_to_json(problem)
     if extra:
         doc.update(extra)
     doc["search"] = dict(search)
@@ -161,7 +162,8 @@ def plan_document(
 
 def controller_to_json(problem: ArrangementProblem) -> dict[str, Any]:
     """The problem's push controller as its ``controller:`` mapping reads, in the problem's
-    units (omitted keys were left at their defaults)."""
+    units (omitted keys were left at their defaults; the servo's only keys are its speed and
+    force)."""
     controller = problem.controller
     length = problem.units.length_factor
     scale = {
@@ -172,9 +174,10 @@ def controller_to_json(problem: ArrangementProblem) -> dict[str, Any]:
         "torque": length * length,
     }
     data: dict[str, Any] = {"kind": controller.kind.value}
+    servo = controller.kind is ControllerKind.SERVO
     for key, factor in scale.items():
         value = getattr(controller, key)
-        if value is not None:
+        if value is not None and not (servo and key not in SERVO_KEYS):
             data[key] = _round(value / factor)
     return data
 
@@ -334,6 +337,17 @@ def plan_problem_mismatch(document: Mapping[str, Any], problem: ArrangementProbl
     recorded = document.get("problem", {}) if isinstance(document, Mapping) else {}
     if not isinstance(recorded, Mapping):
         return f"its 'problem' is {_json_kind(recorded)}, not an object naming the problem"
+    # A plan file that records its problem but no controller was made under the servo.
+    legacy = {"kind": ControllerKind.SERVO.value} if recorded else None
+    controller = document.get("controller", legacy) if isinstance(document, Mapping) else None
+    kind = controller.get("kind") if isinstance(controller, Mapping) else controller
+    if controller is not None and kind != problem.controller.kind.value:
+        return (
+            f"it was planned under the {kind if isinstance(kind, str) else _shown(kind)} "
+            f"controller; problem {problem.name!r} uses "
+            f"the {problem.controller.kind.value} one (a plan file without a 'controller' was "
+            "made under the servo)"
+        )
     if recorded.get("hash") not in (None, problem_hash(problem)):
         return (
             f"it was planned for problem {recorded.get('name')!r} with other content "

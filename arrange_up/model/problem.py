@@ -214,7 +214,7 @@ class Controller:
     ``kp_angle`` and ``torque`` are used by ``compliant`` only.
     """
 
-    kind: ControllerKind = ControllerKind.SERVO
+    kind: ControllerKind = ControllerKind.COMPLIANT
     kp: float = 300.0
     """Proportional gain per axis (mass/s^2: force per inch of tracking error)."""
     kp_angle: float | None = None
@@ -228,7 +228,13 @@ class Controller:
 
 
 DEFAULT_CONTROLLER = Controller()
-"""The controller of a problem that names none (and of every PDDL problem)."""
+"""The controller of a problem that names none (and of every PDDL problem): the compliant one
+at its documented defaults (the measurements that chose them are in docs/design/physics.md)."""
+
+SERVO_CONTROLLER = Controller(kind=ControllerKind.SERVO)
+"""The servo at its defaults: the controller of every problem before problems named one (and
+the default until the compliant controller replaced it). Plan files and records that name no
+controller were made with it."""
 
 
 @dataclass(frozen=True)
@@ -304,8 +310,10 @@ def problem_hash(problem: ArrangementProblem) -> str:
     controller in internal units, with numbers rounded to 9 significant digits, so the same
     problem written in other units or in another format (``.yaml`` or ``.pddl``) hashes the
     same. The description, the file's units and its location are not part of the content; nor
-    is the controller when it is :data:`DEFAULT_CONTROLLER` (so problems that name none hash as
-    they did before the controller was part of the problem).
+    is the controller when it is :data:`SERVO_CONTROLLER`, the controller every problem had
+    before problems named one: a servo problem hashes as it did then, so plan files and records
+    made then still match the problem they were made for, and no longer match the same file
+    under today's default controller.
     """
 
     def canonical(value: object) -> object:
@@ -314,7 +322,7 @@ def problem_hash(problem: ArrangementProblem) -> str:
                 f.name: canonical(getattr(value, f.name))
                 for f in dataclasses.fields(value)
                 if f.name not in ("description", "units", "source")
-                and not (f.name == "controller" and getattr(value, f.name) == DEFAULT_CONTROLLER)
+                and not (f.name == "controller" and getattr(value, f.name) == SERVO_CONTROLLER)
             }
         if isinstance(value, enum.Enum):
             return value.value

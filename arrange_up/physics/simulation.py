@@ -59,7 +59,8 @@ Model
 
 The push controller (servo)
 ===========================
-The default controller (``problem.controller.kind == "servo"``). The thesis drives the paddle
+With ``problem.controller.kind == "servo"`` (the compliant controller below is the default). The
+thesis drives the paddle
 with a clipped PD controller toward the reference point
 ``ref = approach + distance * push_direction``::
 

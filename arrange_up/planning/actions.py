@@ -33,7 +33,10 @@ Distances:
   wall, where it would only push parts off; under the compliant controller not once the part
   and that train all lie within their goal intervals along the push (pressing them into the
   wall again only perturbs them, a new belief each time, a plateau without end; under the
-  servo the repeat is a no-op the search prunes as a duplicate);
+  servo the repeat is a no-op the search prunes as a duplicate), unless
+  ``settled_wall_pushes`` (the planner sets it for semantics that predict rather than simulate
+  a push, i.e. CBST: there a repeat is a duplicate, and it narrows intervals until later
+  contacts are certain);
 * to the part's goal coordinate along the direction, when that lies ahead;
 * each of ``planning.push_distances`` (how far the part should travel).
 
@@ -114,10 +117,12 @@ class ActionGenerator:
         checker: CollisionChecker,
         *,
         unclipped_pushes: bool = False,
+        settled_wall_pushes: bool = False,
     ) -> None:
         self.problem = problem
         self.checker = checker
         self.unclipped_pushes = unclipped_pushes
+        self.settled_wall_pushes = settled_wall_pushes
         hints = problem.planning
         self.directions = tuple(hints.push_directions or DIRECTIONS)
         self.push_distances = tuple(hints.push_distances or ())
@@ -395,7 +400,11 @@ class ActionGenerator:
             wall in self.problem.table.walls
             and train is not None
             and all(q in belief for q in train)
-            and not (self.compliant and self._settled((name, *train), belief, axis))
+            and not (
+                self.compliant
+                and not self.settled_wall_pushes
+                and self._settled((name, *train), belief, axis)
+            )
         ):
             boundary = size if sign > 0 else 0.0
             candidates.append(sign * boundary - front)

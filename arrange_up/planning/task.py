@@ -88,7 +88,10 @@ class BeliefTask:
             checker = CollisionChecker(problem)
             goal = GoalTest(problem)
             generator = ActionGenerator(
-                problem, checker, unclipped_pushes=model.refuses_uncertain_contacts
+                problem,
+                checker,
+                unclipped_pushes=model.refuses_uncertain_contacts,
+                settled_wall_pushes=not model.simulates_pushes,
             )
             estimate = make_heuristic(heuristic, problem, goal, checker, generator)
         except BaseException:

@@ -42,12 +42,20 @@ class Semantics(Protocol):
         miss or wholly cover every part ahead (see :mod:`arrange_up.planning.actions`). False
         for a semantics that predicts every push (``particles``, ``deterministic``); a class
         that subclasses this protocol inherits False.
+    simulates_pushes
+        True when a push's outcome is simulated in the physics (``particles``,
+        ``deterministic``): pressing parts already at their goal into a wall again then gives
+        a new, slightly perturbed belief each time under the compliant controller, so the
+        planner does not propose it. False for a learned prediction (CBST), which is a function
+        of the belief (a repeat is a duplicate) and which needs such pushes to narrow intervals
+        until later contacts are certain. A class that subclasses this protocol inherits True.
     """
 
     name: str
     particles: int
     simulations: int
     refuses_uncertain_contacts: bool = False
+    simulates_pushes: bool = True
 
     def initial_belief(self) -> Any: ...
 

@@ -78,6 +78,7 @@ class CBSTSemantics:
     #: The contact graph refuses a push whose paddle may or may not touch a block, so the
     #: planner also proposes paddle positions that avoid such contacts.
     refuses_uncertain_contacts = True
+    simulates_pushes = False  # a learned prediction (see transitions.Semantics)
 
     def __init__(
         self,

@@ -126,6 +126,7 @@ class ParticleSemantics:
 
     name = "particles"
     refuses_uncertain_contacts = False  # it predicts every push (see transitions.Semantics)
+    simulates_pushes = True
 
     def __init__(
         self, problem: ArrangementProblem, *, particles: int = 50, seed: int = 0, workers: int = 1

@@ -165,7 +165,7 @@ def test_an_exhausted_search_says_so_and_why_in_text_and_json(tmp_path):
     assert shown.exit_code == 1
     status, why = shown.output.splitlines()
     assert status.startswith("obstacle: exhausted (particles, 5 particles, seed 0)")
-    assert why.startswith("exhausted after 7 nodes: 0 candidates refused by the semantics")
+    assert why.startswith("exhausted after 3 nodes: 0 candidates refused by the semantics")
     assert why.endswith("by the ordering filter; the best belief still misses A in x")
     assert "pruned as dominated" in why and "unsolvable" not in shown.output
     summary = json.loads(run(*args, "--json", "-o", str(tmp_path / "p.json")).stdout)

@@ -8,7 +8,7 @@ import struct
 from pathlib import Path
 
 import pytest
-from catalogue import tiny
+from catalogue import servo, tiny
 
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.evaluation.rollouts import trace_rollout
@@ -39,7 +39,7 @@ def png_size(path: Path) -> tuple[int, int]:
 
 
 def test_data_has_a_state_and_a_belief_before_and_after_each_action():
-    problem = tiny("one-block")
+    problem = servo(tiny("one-block"))  # PLAN's distances are the servo's
     calls = []
     data = storyboard_data(
         problem, PLAN, rollouts=3, seed=2, progress=lambda done, total: calls.append((done, total))

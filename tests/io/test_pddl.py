@@ -22,6 +22,7 @@ from arrange_up.io.pddl import (
 from arrange_up.io.shape_catalogue import build_shape, load_catalogue
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import (
+    SERVO_CONTROLLER,
     ObjectKind,
     ObjectSpec,
     PlanningHints,
@@ -116,6 +117,9 @@ def test_export_refuses_what_pddl_cannot_express():
     )
     assert "planning.push_distances" in message
     assert len(caught.value.reasons) == 2
+    # A PDDL problem is driven by the default controller: a servo problem cannot be written.
+    with pytest.raises(PddlExportError, match="controller: kind servo"):
+        write_pddl_problem(dataclasses.replace(problem, controller=SERVO_CONTROLLER))
 
 
 def test_export_refuses_names_pddl_cannot_carry():

@@ -11,7 +11,7 @@ import stat
 from pathlib import Path
 
 import pytest
-from catalogue import tiny, variant
+from catalogue import servo, tiny, variant
 
 from arrange_up.io.planfile import (
     PLAN_FORMAT,
@@ -265,6 +265,12 @@ def test_plan_problem_mismatch_warns_only_for_other_content():
     # The same content in other units is the same problem.
     renamed = variant("millimetres", "name: millimetres", "name: one-block")
     assert plan_problem_mismatch(doc, renamed) is None
+    # Another controller is named as such; a file naming no controller was made by the servo.
+    servo_doc = document(servo(one), ACTIONS[:2])
+    assert "planned under the servo controller" in plan_problem_mismatch(servo_doc, one)
+    legacy = {k: v for k, v in servo_doc.items() if k != "controller"}
+    assert plan_problem_mismatch(legacy, servo(one)) is None
+    assert "planned under the servo controller" in plan_problem_mismatch(legacy, one)
     # Nothing recorded: nothing to compare.
     assert plan_problem_mismatch({"format": PLAN_FORMAT}, mm) is None
     assert plan_problem_mismatch([], mm) is None  # type: ignore[arg-type]

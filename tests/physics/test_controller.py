@@ -8,10 +8,12 @@ from dataclasses import replace
 
 import pytest
 
+from arrange_up.io.domains import load
 from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import (
     DEFAULT_CONTROLLER,
+    SERVO_CONTROLLER,
     Controller,
     ControllerKind,
     ObjectKind,
@@ -28,14 +30,21 @@ def _noise(friction: float = 0.4, density: float = 0.125) -> ActionNoise:
     return ActionNoise((0.0, 0.0, 0.0), friction, density, 0.4)
 
 
-def test_explicit_servo_is_the_default_and_hashes_alike():
+def test_compliant_is_the_default_and_the_servo_hashes_as_problems_did_before_controllers():
     problem, state, push = scene("1 block")
-    servo = replace(problem, controller=Controller(kind=ControllerKind.SERVO))
-    assert servo.controller == DEFAULT_CONTROLLER
-    assert problem_hash(servo) == problem_hash(problem)
-    assert simulate(servo, state, push, _noise()) == simulate(problem, state, push, _noise())
-    compliant = replace(problem, controller=COMPLIANT)
-    assert problem_hash(compliant) != problem_hash(problem)
+    assert problem.controller == DEFAULT_CONTROLLER == COMPLIANT
+    explicit = replace(problem, controller=Controller(kind=ControllerKind.COMPLIANT))
+    assert problem_hash(explicit) == problem_hash(problem)
+    assert simulate(explicit, state, push, _noise()) == simulate(problem, state, push, _noise())
+    # The servo is left out of the hash (SERVO_CONTROLLER): a servo problem hashes as every
+    # problem did before problems named their controller, the default one does not.
+    servo = replace(problem, controller=SERVO_CONTROLLER)
+    assert problem_hash(servo) != problem_hash(problem)
+    # tz-mating's hash in the plan files written while the servo was every problem's controller.
+    tz = replace(load("tz-mating"), controller=SERVO_CONTROLLER)
+    assert problem_hash(tz) == (
+        "sha256:f85ebb7f6bc916bfea2c633b951126c45d91a7e7fcba70eb40f58d55f32a1561"
+    )
 
 
 def test_compliant_free_push_ends_at_its_target_without_overshoot():
@@ -56,7 +65,7 @@ def test_compliant_free_push_ends_at_its_target_without_overshoot():
 
 def test_compliant_resisted_push_stops_short_more_under_more_friction_and_mass():
     problem, state, push = scene("1 block")
-    servo = simulate(problem, state, push, _noise())
+    servo = simulate(replace(problem, controller=SERVO_CONTROLLER), state, push, _noise())
     problem = replace(problem, controller=COMPLIANT)
     light = simulate(problem, state, push, _noise(0.25, 0.1))
     heavy = simulate(problem, state, push, _noise(0.55, 0.15))
@@ -133,12 +142,15 @@ def test_default_angle_gain_makes_the_wrist_as_stiff_as_the_arm():
     assert torque == pytest.approx(400.0 * 1.25)
 
 
-def test_plan_files_record_a_controller_that_is_not_the_default():
+def test_plan_files_record_the_controller():
     from arrange_up.io.planfile import plan_document
 
-    servo = load_problem_text(_FILE)
+    default = load_problem_text(_FILE)
+    servo = load_problem_text(_FILE + "controller: {kind: servo, speed: 2.54}\n")
     compliant = load_problem_text(_FILE + "controller: {kind: compliant, speed: 2.54}\n")
     kw = {"status": "solved", "semantics": "deterministic", "seed": 0, "search": {}}
-    assert "controller" not in plan_document(servo, (), **kw)
+    assert plan_document(default, (), **kw)["controller"] == {"kind": "compliant", "kp": 300.0}
+    # The servo's record names only the keys the servo reads.
+    assert plan_document(servo, (), **kw)["controller"] == {"kind": "servo", "speed": 2.54}
     recorded = plan_document(compliant, (), **kw)["controller"]
     assert recorded == {"kind": "compliant", "kp": 300.0, "speed": 2.54}  # in the file's cm

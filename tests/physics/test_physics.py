@@ -3,6 +3,7 @@ problems built in code."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import subprocess
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 
 from arrange_up.model.problem import (
+    SERVO_CONTROLLER,
     ArrangementProblem,
     Goal,
     ObjectKind,
@@ -111,6 +113,8 @@ def test_force_clip_grows_with_heavy_parts_only():
     problem = make_problem(1, uncertainty=heavy)
     nominal_load = DEFAULT_SETTINGS.gravity * 0.4 * 3.0 * 1.0  # one 1 x 1 in block
     assert push_force(problem) == pytest.approx(1.5 * nominal_load)
+    # The servo (the compliant controller would stop short by about friction / Kp, 1.5 in here).
+    problem = dataclasses.replace(problem, controller=SERVO_CONTROLLER)
     state = state_of(problem, b0=(5.0, 2.5, 0.0))
     nominal = ActionNoise(friction=0.4, part_density=3.0)
     moved = simulate(problem, state, push_east(5.0, 2.5, 1.0), nominal)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from catalogue import tiny, variant, with_planning
+from catalogue import servo, tiny, variant, with_planning
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
@@ -165,7 +165,8 @@ def test_place_candidates_for_relative_goal_follow_reference():
 
 # -- push ----------------------------------------------------------------------------------
 def test_pushes_go_towards_the_goal_to_the_wall_and_to_the_goal_coordinate():
-    gen = generator(tiny("one-block"))  # goal A at (4.5, 0.5), against the right and bottom walls
+    # goal A at (4.5, 0.5), against the right and bottom walls
+    gen = generator(servo(tiny("one-block")))
     pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))
     assert {direction_of(p) for p in pushes} == {"+x", "-y"}  # never away from the goal
     (plus_x,) = {p.pose for p in pushes if direction_of(p) == "+x"}
@@ -234,7 +235,7 @@ def test_a_push_beside_a_wall_is_shifted_along_the_paddle_but_still_covers_the_p
 
 
 def test_wall_pushes_wait_for_the_train_of_parts_ahead():
-    gen = generator(tiny("two-blocks-row"))
+    gen = generator(servo(tiny("two-blocks-row")))
     # The goal holds B against the right wall only through A; A against the right wall itself.
     assert gen.wall_trains[("B", "+x")] == ("A",)
     assert gen.wall_trains[("A", "+x")] == ()
@@ -260,7 +261,7 @@ def test_relative_goals_have_no_wall_trains():
 
 def test_push_hints_restrict_directions_and_add_distances():
     problem = with_planning("one-block", '{push_directions: ["+x"], push_distances: [0.5, 0.501]}')
-    gen = generator(problem)
+    gen = generator(servo(problem))
     assert gen.directions == ("+x",)
     pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))
     assert {direction_of(p) for p in pushes} == {"+x"}
@@ -270,7 +271,7 @@ def test_push_hints_restrict_directions_and_add_distances():
 
 
 def test_a_part_at_its_goal_coordinate_gets_no_push_to_it():
-    gen = generator(tiny("one-block"))
+    gen = generator(servo(tiny("one-block")))
     at_x = belief(A=((4.5 - MIN_PUSH / 2, 1.5, 0.0), SMALL))
     pushes = gen.pushes(at_x)
     (pose,) = {p.pose for p in pushes if direction_of(p) == "+x"}
@@ -278,7 +279,8 @@ def test_a_part_at_its_goal_coordinate_gets_no_push_to_it():
     assert distances(pushes, "+x") == pytest.approx(
         [5.0 - pose[0] - PADDLE_HALF_THICKNESS], abs=1e-4
     )
-    pushes = generator(tiny("obstacle")).pushes(belief(A=((5.0 - MIN_PUSH / 2, 2.5, 0.0), SMALL)))
+    obstacle = servo(tiny("obstacle"))
+    pushes = generator(obstacle).pushes(belief(A=((5.0 - MIN_PUSH / 2, 2.5, 0.0), SMALL)))
     assert "+x" not in {direction_of(p) for p in pushes}  # nothing to gain, and no wall
 
 

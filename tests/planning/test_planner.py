@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 import pytest
-from catalogue import tiny
+from catalogue import servo, tiny
 
 from arrange_up.belief.goals import GoalTest
 from arrange_up.io.domains import load
@@ -216,7 +216,7 @@ goal:
 
 
 def test_a_search_that_runs_out_of_candidates_is_exhausted_and_says_why():
-    result = plan(tiny("obstacle"), particles=5, workers=1)
+    result = plan(servo(tiny("obstacle")), particles=5, workers=1)
     assert result.status is SearchStatus.EXHAUSTED and result.status == "exhausted"
     assert result.actions is None and result.stats["expanded"] == 7
     # The best belief is the one of the smallest heuristic value: A still short of x = 5.

@@ -11,6 +11,7 @@ import json
 import math
 
 import pytest
+from catalogue import servo
 from click.testing import CliRunner
 
 import arrange_up.repair as rp
@@ -141,6 +142,8 @@ def test_a_push_off_the_table_is_caught_by_a_fixture_but_a_plan_short_of_the_goa
     # noise and +-15 deg of rotation some particles leave the table unless something stops
     # them; a fixture (clamped to the table) placed at the edge does. But the plan never
     # reaches the goal, so neither does its repair: the repair says so instead of "solved".
+    # (A servo push: it ends where it was sent.)
+    down_push = servo(down_push)
     nominal = (Push("paddle", (6.0, 6.816804, -math.pi), 6.0418),)
     assert _reaches_goal(down_push, nominal) is False  # valid, but misses the goal
     result = rp.repair_plan(down_push, nominal, particles=8, seed=0)
@@ -160,7 +163,7 @@ def test_a_push_off_the_table_fails_honestly_without_fixtures(down_push):
     import dataclasses
 
     bare = dataclasses.replace(
-        down_push, objects=tuple(o for o in down_push.objects if o.name != "bar")
+        servo(down_push), objects=tuple(o for o in down_push.objects if o.name != "bar")
     )
     nominal = (Push("paddle", (6.0, 6.816804, -math.pi), 6.0418),)
     result = rp.repair_plan(bare, nominal, particles=8, seed=0)

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from catalogue import servo
 
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief
@@ -159,8 +160,9 @@ def _outcomes(problem, belief, push, n, seed=0):
 def test_predicted_boxes_contain_simulated_outcomes():
     """Conservativeness on the blocks-3 case of a two-row push: B compressed against A in
     row 1 while C, flush in row 2, may be grazed. Every simulated outcome lies in the box
-    (within 0.005 in / 0.5 degree, the physics' contact slop)."""
-    problem = load("blocks-3")
+    (within 0.005 in / 0.5 degree, the physics' contact slop). Under the servo, the controller
+    the model was trained in."""
+    problem = servo(load("blocks-3"))
     s = CBSTSemantics(problem)
     b = IntervalBelief(
         (
@@ -210,7 +212,7 @@ def test_plans_a_row_of_four_against_a_wall():
     text = text.replace("C: [9.5, 1.5, 0]", "C: [7.5, 0.5, 0]").replace(
         "D: [8.5, 1.5, 0]", "D: [6.5, 0.5, 0]"
     )
-    problem = load_problem_text(text, "row-of-four.yaml")
+    problem = servo(load_problem_text(text, "row-of-four.yaml"))  # the model's controller
     assert [problem.goal.target(n)[:2] for n in "ABCD"] == [
         (9.5, 0.5),
         (8.5, 0.5),

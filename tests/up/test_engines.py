@@ -330,7 +330,7 @@ def test_an_exhausted_search_is_incomplete_and_a_too_large_part_proven_unsolvabl
     assert exhausted.status is Status.UNSOLVABLE_INCOMPLETELY and exhausted.plan is None
     assert exhausted.metrics["status"] == "exhausted"
     message = exhausted.log_messages[0].message
-    assert message.startswith("exhausted after 7 nodes: ") and "not proven unsolvable" in message
+    assert message.startswith("exhausted after 3 nodes: ") and "not proven unsolvable" in message
     big, _ = check_problem_text(
         "name: big\ntable: {size: [3, 2]}\nobjects:\n  A: {kind: part, shape: {box: [4, 3]}}\n"
         "  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}\n"
