@@ -79,7 +79,8 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
         names.setdefault(key, path)
         if not quiet:
             click.echo(
-                f"{shown}: ok: {problem.name} ({len(problem.parts)} parts, "
+                f"{shown}: ok: {problem.name} ({len(problem.parts)} "
+                f"part{'s' if len(problem.parts) != 1 else ''}, "
                 f"{'relative' if problem.goal.is_relative else 'absolute'} goal)"
             )
     if failed:

@@ -38,6 +38,14 @@ Distances:
   a push, i.e. CBST: there a repeat is a duplicate, and it narrows intervals until later
   contacts are certain);
 * to the part's goal coordinate along the direction, when that lies ahead;
+* **narrowing**: when the part's centre is already (within ``MIN_PUSH``) at its goal
+  coordinate but its spread along the direction misses the goal interval, to where the
+  nominal part would sit at the target, in both directions: the states behind the target are
+  swept up to it, those ahead left alone, and the push from the other side does the rest
+  (a squeeze between two pushes where no wall can do it);
+* **a ladder** of travels (``LADDER``) for a part without a goal position of its own (the
+  reference of a relative goal), keeping its nominal footprint on the table, offered only
+  while some goal part cannot be placed at all (the reference may have to make room);
 * each of ``planning.push_distances`` (how far the part should travel).
 
 Under the compliant controller (``problem.controller.kind == "compliant"``) a resisted push
@@ -91,6 +99,9 @@ APPROACH_GAP = 0.02
 MIN_PUSH = 0.05
 #: Candidate distances closer than this are considered the same (inches).
 DISTANCE_RESOLUTION = 0.01
+#: Travels (in) offered to a part with no goal position of its own (the reference of a
+#: relative goal), which goal-directed distances never move.
+LADDER = (0.5, 1.0, 2.0)
 #: Parts ahead of a pushed part within this gap (in) count as moved with it by the push, for
 #: the compliant controller's stall.
 CONTACT_GAP = 0.1
@@ -262,6 +273,14 @@ class ActionGenerator:
     # -- push ------------------------------------------------------------------------------
     def pushes(self, belief: IntervalBelief) -> list[Push]:
         on_table = self._shadows(belief)
+        # The ladder for parts without a goal position only when a goal part cannot be placed:
+        # otherwise the goal-directed actions make progress, and the ladder only widens the
+        # search (relative matings expanded 13 times the nodes with it always on).
+        ladder = any(
+            spec.name not in belief and not self.places(belief, only=spec.name)
+            for spec in self.problem.parts
+            if spec.name in self.problem.goal.parts
+        )
         actions: list[Push] = []
         for manip in self.manipulators:
             if manip.spec.name in belief:
@@ -272,11 +291,15 @@ class ActionGenerator:
                     continue
                 for direction in self.directions:
                     actions.extend(
-                        self._pushes_of(manip, spec.name, interval, direction, belief, on_table)
+                        self._pushes_of(
+                            manip, spec.name, interval, direction, belief, on_table, ladder
+                        )
                     )
         return actions
 
-    def _pushes_of(self, manip, name, interval, direction, belief, on_table) -> list[Push]:
+    def _pushes_of(
+        self, manip, name, interval, direction, belief, on_table, ladder=False
+    ) -> list[Push]:
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
         sign = int(ux + uy)  # +1 or -1
@@ -294,7 +317,7 @@ class ActionGenerator:
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
-        distances = self._distances(name, interval, belief, axis, sign, front_nominal)
+        distances = self._distances(name, interval, belief, axis, sign, front_nominal, ladder)
         pushes = []
         for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
             pose = (along, across, theta) if axis == 0 else (across, along, theta)
@@ -384,7 +407,7 @@ class ActionGenerator:
         return low, high
 
     def _distances(
-        self, name, interval, belief, axis, sign, front
+        self, name, interval, belief, axis, sign, front, ladder=False
     ) -> list[tuple[float, float | None]]:
         """Candidate travel distances of the manipulator (see the module docstring), each with
         the travel of the part it is meant for (``None`` for a push to the wall)."""
@@ -411,15 +434,41 @@ class ActionGenerator:
         target = self.place_target(name, belief)
         stall = self._stall(name, belief, axis, sign) if self.stall_per_area else 0.0
         travels: dict[float, float | None] = {candidates[0]: None} if candidates else {}
+        # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
+        # a narrowing push, to the contact of the rearmost state.
+        least: dict[float, float] = {}
         if target is not None:
             travel = sign * (target[axis] - interval.center[axis])
+            half = interval.half[axis]
             if travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
+            elif (
+                abs(target[axis] - interval.center[axis]) + half
+                > self.problem.goal.tolerance[axis] + 1e-9
+                and travel + half > MIN_PUSH
+            ):
+                # Narrowing: the centre is (about) on target but the spread misses the goal.
+                # The push ends where the nominal part would sit at its target, so the states
+                # behind it are swept up to the target and those ahead are left alone; a push
+                # from the other side does the rest.
+                d = gap + travel + stall
+                travels.setdefault(d, None)
+                least[d] = gap - half
+        elif ladder and not candidates and not self.push_distances:
+            # No goal position (the reference part of a relative goal): a short ladder of
+            # travels, those that keep the part's nominal footprint on the table.
+            low, high = (nominal[axis], nominal[axis + 2])
+            for d in LADDER:
+                shifted = (low + sign * d, high + sign * d)
+                if shifted[0] >= 0.0 and shifted[1] <= size:
+                    travels.setdefault(gap + d + stall, d)
         for d in self.push_distances:
             travels.setdefault(gap + d + stall, d)
         result: list[tuple[float, float | None]] = []
         for d in sorted(travels):
-            if d > gap + MIN_PUSH and all(abs(d - r) > DISTANCE_RESOLUTION for r, _ in result):
+            if d > least.get(d, gap) + MIN_PUSH and all(
+                abs(d - r) > DISTANCE_RESOLUTION for r, _ in result
+            ):
                 result.append((d, travels[d]))
         return result
 

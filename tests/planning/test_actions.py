@@ -10,6 +10,7 @@ from catalogue import servo, tiny, variant, with_planning
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.world import Pick, Place, Push
 from arrange_up.planning.actions import MIN_PUSH, ActionGenerator
 
@@ -343,3 +344,54 @@ def test_push_that_clips_a_neighbour_is_also_offered_clear_of_it():
     assert centres_pushing_d_down(IntervalBelief((("B", d_iv),))) == [6.088]
     # Off by default (particle semantics simulate clipped contacts): one position only.
     assert centres_pushing_d_down(state, ActionGenerator(p, checker)) == [6.088]
+
+
+# -- pushes where the goal-directed ones cannot make progress (issue: complete generation) ----
+def test_a_belief_centred_on_its_goal_but_too_wide_is_offered_narrowing_pushes_both_ways():
+    # Goal A at (2.5, 0.5): no wall holds it in x; the belief is centred on that x, spread
+    # +-0.3 in x against a tolerance of +-0.2.
+    problem = variant("one-block", "poses: {A: [4.5, 0.5, 0]}", "poses: {A: [2.5, 0.5, 0]}")
+    gen = generator(servo(problem))
+    wide = belief(A=((2.5, 1.5, 0.0), (0.3, 0.1, 0.05)))
+    pushes = gen.pushes(wide)
+    assert {"+x", "-x"} <= {direction_of(p) for p in pushes}
+    for direction, sign in (("+x", 1), ("-x", -1)):
+        (pose,) = {p.pose for p in pushes if direction_of(p) == direction}
+        (d,) = distances(pushes, direction)
+        # The paddle's front ends where the nominal part's rear sits at the target.
+        front_end = pose[0] + sign * (PADDLE_HALF_THICKNESS + d)
+        assert front_end == pytest.approx(2.5 - sign * 0.5, abs=1e-4)
+    # Within the tolerance already: nothing to narrow, no push along x.
+    narrow = belief(A=((2.5, 1.5, 0.0), (0.1, 0.1, 0.05)))
+    assert not {"+x", "-x"} & {direction_of(p) for p in gen.pushes(narrow)}
+
+
+RELATIVE_PAIR = """
+name: pair
+table: {size: [8, 6], walls: []}
+objects:
+  A: {kind: part, shape: {box: [1, 1]}}
+  B: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+initial:
+  A: {pose: [7.2, 3, 0], uncertainty: [0.05, 0.05, 2]}
+goal:
+  tolerance: [0.3, 0.3, 15]
+  relative: {reference: A, poses: {B: [1.0, 0.0, 0]}}
+uncertainty: {place: [0.2, 0.2, 15], push: [0.05, 0.05, 3]}
+"""
+
+
+def test_the_reference_of_a_relative_goal_gets_a_ladder_only_when_a_part_cannot_be_placed():
+    problem = servo(load_problem_text(RELATIVE_PAIR, "pair.yaml"))
+    gen = generator(problem)
+    # A near the right edge: B's place beside it falls off the table, so A must move.
+    edge = belief(A=((7.2, 3.0, 0.0), (0.05, 0.05, 0.03)))
+    assert gen.places(edge) == []
+    west = distances(gen.pushes(edge), "-x")
+    assert west and len(west) == 3  # the ladder's three travels, each on the table
+    # None that would push A's footprint off the table's right edge.
+    assert "+x" not in {direction_of(p) for p in gen.pushes(edge)}
+    # A in the middle: B can be placed, no ladder.
+    middle = belief(A=((3.0, 3.0, 0.0), (0.05, 0.05, 0.03)))
+    assert gen.places(middle) and gen.pushes(middle) == []

@@ -1,0 +1,96 @@
+"""Problems written from the format alone: does each get a reliable plan?
+
+Usage::
+
+    python benchmarks/fresh_problems.py [--particles 20] [--timeout 300] [--rollouts 200]
+        [--problems tests/problems/fresh/*.yaml] [--output fresh.csv]
+
+For each problem file (default: every file of ``tests/problems/fresh/``, written for issue 13's
+kinds: a narrowing squeeze, a detour round a post, a relative pair whose reference must move,
+an open-table goal that needs a fixture, an L part into a corner, a 5-block T, a column of four,
+a tight row), plans as ``arrange-up plan FILE --particles N`` does (seed 0, one worker), then
+evaluates a found plan with ``--rollouts`` noisy rollouts (seed 0) and prints a row: status,
+nodes expanded, planning seconds, plan length, successes, and the planner's reason when no plan
+was found. Each row is appended to the CSV (if given) as soon as it is measured.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import time
+from pathlib import Path
+
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.io.yaml_problem import load_problem
+from arrange_up.planning.planner import plan
+
+FRESH = Path(__file__).resolve().parents[1] / "tests" / "problems" / "fresh"
+FIELDS = [
+    "problem",
+    "controller",
+    "particles",
+    "status",
+    "expanded",
+    "seconds",
+    "plan_length",
+    "rollouts",
+    "successes",
+    "reason",
+]
+
+
+def measure(path: Path, particles: int, timeout: float, rollouts: int) -> dict[str, object]:
+    problem = load_problem(path)
+    started = time.perf_counter()
+    result = plan(problem, particles=particles, seed=0, workers=1, timeout=timeout)
+    seconds = time.perf_counter() - started
+    row: dict[str, object] = {
+        "problem": problem.name,
+        "controller": problem.controller.kind.value,
+        "particles": particles,
+        "status": str(result.status),
+        "expanded": result.stats["expanded"],
+        "seconds": round(seconds, 1),
+        "plan_length": len(result.actions) if result.actions else "",
+        "rollouts": "",
+        "successes": "",
+        "reason": result.reason or "",
+    }
+    if result.solved and rollouts:
+        reliability = evaluate_plan(problem, result.actions, rollouts=rollouts, seed=0, workers=1)
+        row.update(rollouts=reliability.trials, successes=reliability.successes)
+    return row
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--problems", nargs="*", type=Path, default=None)
+    parser.add_argument("--particles", type=int, default=20)
+    parser.add_argument("--timeout", type=float, default=300.0, help="planning seconds")
+    parser.add_argument("--rollouts", type=int, default=200)
+    parser.add_argument("--output", type=Path, default=None)
+    args = parser.parse_args()
+    paths = args.problems or sorted(FRESH.glob("*.yaml"))
+    writer = None
+    handle = None
+    if args.output is not None:
+        new = not args.output.exists()
+        handle = args.output.open("a", newline="", encoding="utf-8")
+        writer = csv.DictWriter(handle, FIELDS)
+        if new:
+            writer.writeheader()
+    try:
+        for path in paths:
+            row = measure(path, args.particles, args.timeout, args.rollouts)
+            print(" ".join(f"{k}={row[k]}" for k in FIELDS if row[k] != ""), flush=True)
+            if writer is not None and handle is not None:
+                writer.writerow(row)
+                handle.flush()
+    finally:
+        if handle is not None:
+            handle.close()
+
+
+if __name__ == "__main__":
+    main()
