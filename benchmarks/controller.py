@@ -47,7 +47,13 @@ import numpy as np
 
 from arrange_up.evaluation.rollouts import Rollouts
 from arrange_up.io.domains import load
-from arrange_up.model.problem import ArrangementProblem, Controller, ControllerKind, ObjectKind
+from arrange_up.model.problem import (
+    SERVO_CONTROLLER,
+    ArrangementProblem,
+    Controller,
+    ControllerKind,
+    ObjectKind,
+)
 from arrange_up.model.world import Push, WorldState, draw_noise
 from arrange_up.physics.bench import scene
 from arrange_up.physics.simulation import DEFAULT_SETTINGS, simulate, simulate_watched
@@ -219,7 +225,7 @@ def rollout_speed(controller: Controller, rollouts: int) -> tuple[float, float, 
     nominal (servo-planned) plan under ``controller``, in this process. A rollout stops at a
     failing action, so a controller under which the servo's plan fails early runs fewer
     actions per rollout: actions per second is the fair comparison of the physics' speed."""
-    servo_problem = load("blocks-7")
+    servo_problem = replace(load("blocks-7"), controller=SERVO_CONTROLLER)
     actions = plan(servo_problem, semantics="deterministic").actions
     problem = replace(servo_problem, controller=controller)
     runner = Rollouts(problem, actions)
@@ -238,7 +244,7 @@ def rollout_speed(controller: Controller, rollouts: int) -> tuple[float, float, 
 def push_speed(controller: Controller, repeats: int) -> float:
     """Pushes per second of blocks-7's nominal plan's pushes, each from the state the servo's
     noise-free execution of the plan reaches before it, under ``controller`` (noise-free)."""
-    servo_problem = load("blocks-7")
+    servo_problem = replace(load("blocks-7"), controller=SERVO_CONTROLLER)
     actions = plan(servo_problem, semantics="deterministic").actions
     state = WorldState(())
     pushes = []

@@ -24,7 +24,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from arrange_up.io.domains import domain_names, load
-from arrange_up.model.problem import Controller, ControllerKind
+from arrange_up.model.problem import SERVO_CONTROLLER, Controller, ControllerKind
 from arrange_up.model.world import Push
 from arrange_up.planning.planner import plan
 from arrange_up.planning.task import BeliefTask
@@ -48,7 +48,7 @@ def follow_servo(name: str, kp: float | None) -> None:
     servo plan's action (a place) or its push from within 0.1 in of the same approach pose and
     angle with the nearest distance, and print each step's heuristic and whether the goal is
     reached."""
-    servo = load(name)
+    servo = replace(load(name), controller=SERVO_CONTROLLER)
     servo_plan = plan(servo, semantics="deterministic").actions
     controller = Controller(kind=ControllerKind.COMPLIANT)
     if kp is not None:
