@@ -60,6 +60,7 @@ from arrange_up.experiments.planning import (
     transition_comparison,
     transition_markdown,
 )
+from arrange_up.model.problem import ControllerKind
 from arrange_up.parallel import BackendUnavailableError
 from arrange_up.repair import METHODS
 from arrange_up.transitions import available
@@ -77,6 +78,18 @@ def experiment() -> None:
     and about how long they take (from measured costs), then a line per measurement as it
     ends, and the result table on stdout at the end.
     """
+
+
+def _controller_option(function: Any) -> Any:
+    """``--controller``: the controller kind every problem of the experiment is driven by."""
+    return click.option(
+        "--controller",
+        type=click.Choice([kind.value for kind in ControllerKind]),
+        default=None,
+        help="Drive every problem with this push controller at its defaults (default: each "
+        "problem's own, compliant for the shipped ones). Recorded in every row and in the "
+        "CSV's settings: a CSV measured under another controller is refused.",
+    )(function)
 
 
 def _say(message: str) -> None:
@@ -213,6 +226,7 @@ def _refuse_bad_problems(names: list[str]) -> None:
     default=None,
     help="Worker processes (default: all cores).",
 )
+@_controller_option
 @click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
 def experiment_transition_comparison(
     problems: str,
@@ -223,6 +237,7 @@ def experiment_transition_comparison(
     max_nodes: int,
     timeout: float | None,
     workers: int | None,
+    controller: str | None,
     output_dir: str,
 ) -> None:
     """Figures 3-6 and 3-7: planning time and reliability of each belief transition."""
@@ -254,6 +269,7 @@ def experiment_transition_comparison(
                 max_nodes=max_nodes,
                 timeout=timeout,
                 workers=workers,
+                controller=controller,
                 progress=report.say,
                 measured=lambda row: report.done(_transition_line(row)),
             )
@@ -296,6 +312,7 @@ def experiment_transition_comparison(
     help="1 = A*, as in the thesis's table.",
 )
 @timeout_option("Time limit per search, seconds.")
+@_controller_option
 @click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
 def experiment_search_table(
     problems: str,
@@ -304,6 +321,7 @@ def experiment_search_table(
     max_nodes: int,
     weight: float,
     timeout: float | None,
+    controller: str | None,
     output_dir: str,
 ) -> None:
     """Table 3.1: nodes expanded and plan cost for each heuristic, with and without
@@ -332,6 +350,7 @@ def experiment_search_table(
                 max_nodes=max_nodes,
                 weight=weight,
                 timeout=timeout,
+                controller=controller,
                 progress=report.say,
                 measured=lambda row: report.done(_search_line(row)),
             )
@@ -381,6 +400,15 @@ def experiment_search_table(
     "Time limit per repair, seconds (the thesis allowed 24 hours); a repair that reaches "
     "it is recorded with status 'timeout'."
 )
+@click.option(
+    "--ablation/--no-ablation",
+    default=library_default(fixture_experiment, "ablation"),
+    show_default=True,
+    help="Also run each repair without fixtures (the same particles, method and seed; only "
+    "the approach back-off and the push multipliers: 'arrange-up repair --no-fixtures') and "
+    "evaluate it on the same rollouts, so that the fixtures' own share of the gain is a number.",
+)
+@_controller_option
 @parallel_options("rollouts")
 @click.option(
     "--output-dir",
@@ -397,6 +425,8 @@ def experiment_fixtures(
     seed: int,
     method: str,
     timeout: float | None,
+    ablation: bool,
+    controller: str | None,
     workers: int | None,
     backend: str | None,
     scheduler: str | None,
@@ -406,14 +436,18 @@ def experiment_fixtures(
 
     For each problem: --plans distinct nominal (deterministic) plans; each is evaluated over
     --rollouts noisy rollouts, then repaired once per --particles count (arrange-up repair)
-    and the repaired plan evaluated on the same rollouts. --workers processes run both the
-    repairs and the rollouts (on 2 cores, --workers 1 was the faster: with up to 150
-    particles a repair's process pool costs more than it saves); --backend/--scheduler apply
-    to the rollouts only.
+    and the repaired plan evaluated on the same rollouts; unless --no-ablation, each repair
+    is run again without fixtures (arrange-up repair --no-fixtures) and evaluated on the same
+    rollouts too, and the table says how much the fixtures themselves add. --workers
+    processes run both the repairs and the rollouts (on 2 cores, --workers 1 was the faster:
+    with up to 150 particles a repair's process pool costs more than it saves);
+    --backend/--scheduler apply to the rollouts only. --controller drives every problem with
+    that controller (default: its own).
 
     \b
     Writes into --output-dir:
-      fixtures.csv             one row per measurement: the nominal plan, or one repair
+      fixtures.csv             one row per measurement: the nominal plan, one repair, or
+                               one repair without fixtures (stage 'ablation')
       fixtures-overview.png    mean reliability, nominal vs repaired (Figure 4-14)
       fixtures-PROBLEM.png     reliability, repair time and plan length vs particles
                                (Figures 4-16 to 4-25)
@@ -432,7 +466,8 @@ def experiment_fixtures(
       arrange-up experiment fixtures --problems tz-mating --plans 2 --particles 10,40 \\
           --rollouts 100 --output-dir tz-quick
       arrange-up experiment fixtures --plans 5 --particles 10,40,150 --workers 1 \\
-          --output-dir docs/results      # docs/results.md: ~32 min on 2 cores
+          --controller servo --no-ablation --output-dir docs/results/servo
+                                       # docs/results.md's servo rows: ~32 min on 2 cores
       arrange-up experiment fixtures --workers 1   # thesis scale: ~2-3 h on 2 cores (est.)
 
     Exit status: 0 the sweep ran (whatever the results), 1 interrupted, 2 bad input or a CSV
@@ -447,11 +482,17 @@ def experiment_fixtures(
         fail("--problems: expected at least one problem")
     _refuse_bad_problems(names)
     pending = pending_rows(
-        Path(output_dir), problems=names, plans=plans, particles=counts, seed=seed, method=method
+        Path(output_dir),
+        problems=names,
+        plans=plans,
+        particles=counts,
+        seed=seed,
+        method=method,
+        ablation=ablation,
     )
     estimate = costs.Estimate()
-    for name, count in pending:
-        estimate.add(costs.fixture_cost(name, count, rollouts), name)
+    for name, count, stage in pending:
+        estimate.add(costs.fixture_cost(name, count, rollouts, fixtures=stage != "ablation"), name)
     try:
         with _measurements(estimate, len(pending)) as report:
             path = fixture_experiment(
@@ -466,6 +507,8 @@ def experiment_fixtures(
                 workers=workers,
                 backend=backend,
                 scheduler=scheduler,
+                ablation=ablation,
+                controller=controller,
                 progress=report.say,
                 measured=lambda row: report.done(_fixture_line(row)),
             )

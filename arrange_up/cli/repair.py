@@ -98,6 +98,14 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     "meet the part motion swath (enhanced).",
 )
 @click.option(
+    "--no-fixtures",
+    "no_fixtures",
+    is_flag=True,
+    help="The fixtures' ablation: repair exactly as usual but never place a fixture, keeping "
+    "only the approach back-off and the push multipliers, to measure how much of a repair's "
+    "gain the fixtures themselves bring (recorded as \"fixtures\": false under 'repair').",
+)
+@click.option(
     "--workers",
     type=click.IntRange(1, 256),
     default=None,
@@ -118,6 +126,7 @@ def repair(
     particles: int,
     seed: int,
     method: str,
+    no_fixtures: bool,
     workers: int | None,
     output: str | None,
     as_json: bool,
@@ -132,6 +141,7 @@ def repair(
     Examples:
       arrange-up repair tz-mating --particles 150 --output tz.fixtures.json
       arrange-up repair tz-mating --plan tz.nominal.json --method naive --json
+      arrange-up repair tz-mating --plan tz.nominal.json --no-fixtures -o tz.ablation.json
 
     Exit status: 0 repaired, 1 the repair failed (a step whose every candidate pushes a part
     off the table or never comes to rest), 2 bad input.
@@ -153,6 +163,7 @@ def repair(
             method=method,
             workers=available_cores() if workers is None else workers,
             progress=_echo_progress if sys.stderr.isatty() else None,
+            fixtures=not no_fixtures,
         )
     except KeyboardInterrupt:
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
@@ -165,8 +176,10 @@ def repair(
         echo_json(document_summary(document, output, reason=result.reason or None))
     else:
         stats = result.stats()
+        ablation = ", no fixtures" if no_fixtures else ""
         click.echo(
-            f"{loaded.name}: {result.status} ({method}, {particles} particles, seed {seed}) in "
+            f"{loaded.name}: {result.status} ({method}{ablation}, {particles} particles, "
+            f"seed {seed}) in "
             f"{result.elapsed:.1f} s: {stats['pushes']} pushes, {stats['fixtures_placed']} "
             f"fixtures placed, {result.simulations} simulations"
         )

@@ -3,10 +3,11 @@ experiment command can say how long it will take before it starts.
 
 The figures are those of the runs behind ``docs/results.md`` (its commands, on the 2-core
 development machine while other jobs ran; docs/design/figures.md says how each was read
-from the CSVs in ``docs/results/``). They are estimates: wall times on a shared machine vary
-by a factor of two, and a configuration not in the table (another problem, planner or particle
-count) is reported as unknown rather than guessed, except where a cost scales with something
-measured (nodes, particles, rollouts).
+from the CSVs in ``docs/results/servo/``; every one was measured under the servo controller).
+They are estimates: wall times on a shared machine vary by a factor of two, and a
+configuration not in the table (another problem, planner or particle count) is reported as
+unknown rather than guessed, except where a cost scales with something measured (nodes,
+particles, rollouts).
 """
 
 from __future__ import annotations
@@ -80,6 +81,16 @@ REPAIR_SECONDS_PER_PARTICLE: dict[str, float] = {
     "tz-mating": 0.43,
     "create-a-t": 0.31,
     "tt-mating-noisy": 0.36,
+}
+#: The same for a repair without fixtures (the fixtures' ablation: no placement candidates,
+#: so about a twentieth of a full repair): one run with 40 particles on each problem's first
+#: nominal plan under the servo (docs/design/figures.md gives the command).
+ABLATION_SECONDS_PER_PARTICLE: dict[str, float] = {
+    "down-push": 0.011,
+    "tt-mating": 0.023,
+    "tz-mating": 0.023,
+    "create-a-t": 0.020,
+    "tt-mating-noisy": 0.020,
 }
 FIXTURE_ROLLOUT_SECONDS = 0.003
 
@@ -160,11 +171,14 @@ def search_cost(
     return _capped(*table[2 * search + int(domination)], max_nodes)
 
 
-def fixture_cost(problem: str, particles: int | None, rollouts: int) -> float | None:
+def fixture_cost(
+    problem: str, particles: int | None, rollouts: int, *, fixtures: bool = True
+) -> float | None:
     """Seconds of one row of the fixture experiment: a nominal plan's evaluation
-    (``particles`` None) or a repair with ``particles`` and its evaluation; None when the
-    problem's repairs were not measured."""
-    per = REPAIR_SECONDS_PER_PARTICLE.get(problem)
+    (``particles`` None) or a repair with ``particles`` (without fixtures unless ``fixtures``:
+    the ablation) and its evaluation; None when the problem's repairs were not measured."""
+    table = REPAIR_SECONDS_PER_PARTICLE if fixtures else ABLATION_SECONDS_PER_PARTICLE
+    per = table.get(problem)
     if per is None:
         return None
     return per * (particles or 0) + FIXTURE_ROLLOUT_SECONDS * rollouts

@@ -12,7 +12,17 @@ candidates on:
 3. each nominal plan is repaired once per particle count (repair seed ``seed``) and the repaired
    plan is evaluated on the same rollouts (evaluation seed ``seed``: common random numbers, so
    the nominal and repaired rates of a plan are compared on the same noise); one row each,
-   stage ``repaired``.
+   stage ``repaired``;
+4. unless ``ablation`` is off, each of those repairs is run again without fixtures (the same
+   particles, method and seed; :func:`~arrange_up.repair.repair_plan` with ``fixtures=False``:
+   no placement is ever a candidate, the approach back-off and the push multipliers stay) and
+   evaluated on the same rollouts; one row each, stage ``ablation``. The repaired mean minus
+   the ablation's mean is the fixtures' own share of the repair's gain
+   (:func:`fixture_shares`).
+
+Every problem is driven by ``controller`` (a controller kind at its defaults) or, when it is
+``None``, by its own controller; every row records the kind in its ``controller`` column and
+the CSV's settings record it too, so a rerun under another controller is refused.
 
 Nothing is left out silently. A plan index for which ``nominal_plans`` found no plan gets a
 ``nominal`` row with status ``no-plan`` and the reason, and no repair rows. A repair that fails
@@ -22,7 +32,8 @@ plots say how many failed.
 
 The CSV (``fixtures.csv``) gets every row as soon as it is measured; a rerun skips the rows
 already there (keyed by problem, seed, plan, stage, particles and method; changing
-``rollouts`` does not redo them). Nominal plans are recomputed on every run, which is cheap
+``rollouts`` does not redo them; turning ``ablation`` off skips the ablation rows, and on again
+measures only those). Nominal plans are recomputed on every run, which is cheap
 and reproducible: with ``max_tries`` left to its default the list for a smaller ``K`` is a
 prefix of the list for a larger one, so ``K`` can grow between runs. Every row records its
 plan's hash, and evaluated rows count their failed rollouts by kind. A rerun whose nominal
@@ -30,7 +41,8 @@ plan ``j`` differs from the one the CSV was measured on (the planner changed), o
 has other columns, stops with :class:`StaleResultsError` instead of mixing the two.
 
 Plots (:func:`plot_fixture_experiment`): ``fixtures-overview.png`` (Figure 4-14: mean
-reliability of the nominal and the repaired plans per problem) and one
+reliability of the nominal and the repaired plans per problem, and of the repairs without
+fixtures where the rows have them) and one
 ``fixtures-<problem>.png`` per problem with reliability against particles (Figures 4-16, 4-18,
 4-20, 4-22, 4-24) and repair time and plan length against particles (Figures 4-17, 4-19, 4-21,
 4-23, 4-25).
@@ -51,8 +63,8 @@ from matplotlib.patches import Patch
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.records import plan_hash
 from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
+from arrange_up.experiments.problems import controller_setting, driven_problems
 from arrange_up.figures.backend import pyplot
-from arrange_up.io.domains import load
 from arrange_up.model.world import Push
 from arrange_up.parallel import available_cores
 from arrange_up.repair import METHODS, nominal_plans, repair_plan
@@ -67,6 +79,7 @@ __all__ = [
     "StaleResultsError",
     "SummaryRow",
     "fixture_experiment",
+    "fixture_shares",
     "markdown_table",
     "pending_rows",
     "plot_fixture_experiment",
@@ -86,12 +99,18 @@ NO_PLAN = "no-plan"
 ERROR = "error"
 NOMINAL = "nominal"
 REPAIRED = "repaired"
-#: Plot colours of the nominal and the repaired plans.
+#: Stage of the repairs without fixtures (the fixtures' ablation).
+ABLATION = "ablation"
+#: Plot colours of the nominal and the repaired plans, and of the repairs without fixtures.
 NOMINAL_COLOR = "0.6"
 COLOR = "tab:blue"
+ABLATION_COLOR = "tab:purple"
+#: How the table and the plots name the ablation's rows.
+ABLATION_LABEL = "repaired, no fixtures"
 
 FIXTURE_FIELDS = [
     "problem",
+    "controller",
     "seed",
     "plan",
     "stage",
@@ -142,6 +161,8 @@ def fixture_experiment(
     backend: str = "local",
     scheduler: str | None = None,
     max_tries: int | None = None,
+    ablation: bool = True,
+    controller: str | None = None,
     progress: Progress | None = None,
     measured: Callable[[dict[str, Any]], None] | None = None,
 ) -> Path:
@@ -155,7 +176,9 @@ def fixture_experiment(
     :func:`~arrange_up.evaluation.evaluate.evaluate_plan` (default: every core), ``backend`` and
     ``scheduler`` to the evaluation only. ``max_tries`` is passed to ``nominal_plans``
     (default ``10 * max(plans, 20) + 10``, independent of ``plans`` up to 20, which keeps the
-    plan lists of different ``plans`` prefixes of each other).
+    plan lists of different ``plans`` prefixes of each other). ``ablation`` adds the repairs
+    without fixtures (stage ``ablation``); ``controller`` (``"compliant"`` or ``"servo"``)
+    drives every problem by that controller kind at its defaults, ``None`` by its own.
 
     ``progress`` gets a line of text at each stage, ``measured`` every row as it is written.
 
@@ -175,6 +198,7 @@ def fixture_experiment(
     path = Path(output_dir) / CSV_NAME
     _check_columns(path)
     say = progress or (lambda _msg: None)
+    loaded = driven_problems(problems, controller)
 
     def evaluate(problem: Any, actions: Sequence[Any], what: str) -> dict[str, Any]:
         """The evaluation columns of a row (none when ``rollouts`` is 0)."""
@@ -200,7 +224,7 @@ def fixture_experiment(
             **{kind: getattr(result.failures, kind) for kind in FAILURE_KINDS},
         }
 
-    settings = {"rollouts": rollouts, "timeout": timeout}
+    settings = {"rollouts": rollouts, "timeout": timeout, "controller": controller_setting(loaded)}
     with CsvAppender(path, FIXTURE_FIELDS, key=_KEY, settings=settings) as append:
         existing = read_csv(path)  # under the lock: what an earlier run measured
         done = append.done  # grows as rows are written: a repeated problem or count is done too
@@ -211,7 +235,7 @@ def fixture_experiment(
                 measured(row)
 
         for name in problems:
-            problem = load(name)
+            problem = loaded[name]
             say(f"{name}: finding {plans} nominal plan{'s' if plans != 1 else ''}")
             started = time.perf_counter()
             found = nominal_plans(problem, plans, seed, max_tries=tries)
@@ -222,7 +246,12 @@ def fixture_experiment(
                 nominal = found[j] if j < len(found) else None
                 digest = plan_hash(nominal) if nominal is not None else ""
                 _check_not_stale(existing, name, seed, j, digest)
-                base = {"problem": name, "seed": seed, "plan": j}
+                base = {
+                    "problem": name,
+                    "controller": problem.controller.kind.value,
+                    "seed": seed,
+                    "plan": j,
+                }
                 key = _key(name, seed, j, NOMINAL, "", "")
                 if nominal is None:
                     if key not in done:
@@ -250,24 +279,26 @@ def fixture_experiment(
                     row.update(evaluate(problem, nominal, f"{label} nominal"))
                     write(row)
                 for count in particles:
-                    key = _key(name, seed, j, REPAIRED, str(count), method)
-                    if key in done:
-                        continue
-                    what = f"{label} repaired with {count} particles"
-                    say(f"{what}: repairing")
-                    row = _repair_row(
-                        problem, nominal, count, seed, method, timeout, workers, base, digest
-                    )
-                    length = row["plan_length"]
-                    say(
-                        f"{what}: {row['status']} in {row['seconds']} s"
-                        + (f", plan length {length}" if length != "" else "")
-                        + (f" ({row['reason']})" if row["reason"] else "")
-                    )
-                    repaired = row.pop("_actions", None)
-                    if repaired is not None:
-                        row.update(evaluate(problem, repaired, what))
-                    write(row)
+                    for stage in _repair_stages(ablation):
+                        key = _key(name, seed, j, stage, str(count), method)
+                        if key in done:
+                            continue
+                        what = f"{label} {_STAGE_WHAT[stage]} with {count} particles"
+                        say(f"{what}: repairing")
+                        row = _repair_row(
+                            problem, nominal, count, seed, method, timeout, workers, base, digest,
+                            stage=stage,
+                        )  # fmt: skip
+                        length = row["plan_length"]
+                        say(
+                            f"{what}: {row['status']} in {row['seconds']} s"
+                            + (f", plan length {length}" if length != "" else "")
+                            + (f" ({row['reason']})" if row["reason"] else "")
+                        )
+                        repaired = row.pop("_actions", None)
+                        if repaired is not None:
+                            row.update(evaluate(problem, repaired, what))
+                        write(row)
     selected = select_rows(
         read_csv(path),
         problems=problems,
@@ -288,20 +319,23 @@ def pending_rows(
     particles: Sequence[int],
     seed: int,
     method: str,
-) -> list[tuple[str, int | None]]:
-    """The (problem, particles; None for the nominal plan) of each row a
-    :func:`fixture_experiment` call would write, if every nominal plan is found: those not yet
-    in ``output_dir``'s CSV."""
+    ablation: bool = True,
+) -> list[tuple[str, int | None, str]]:
+    """The (problem, particles, stage) of each row a :func:`fixture_experiment` call would
+    write, if every nominal plan is found: those not yet in ``output_dir``'s CSV. Particles
+    are ``None`` for the nominal plan's row (stage ``nominal``); the stages of repairs are
+    ``repaired`` and, with ``ablation``, ``ablation`` (a repair without fixtures)."""
     done = done_keys(Path(output_dir) / CSV_NAME, _KEY)
-    pending: list[tuple[str, int | None]] = []
+    pending: list[tuple[str, int | None, str]] = []
     for name in dict.fromkeys(problems):
         for j in range(plans):
             if _key(name, seed, j, NOMINAL, "", "") not in done:
-                pending.append((name, None))
+                pending.append((name, None, NOMINAL))
             pending += [
-                (name, n)
+                (name, n, stage)
                 for n in dict.fromkeys(particles)
-                if _key(name, seed, j, REPAIRED, str(n), method) not in done
+                for stage in _repair_stages(ablation)
+                if _key(name, seed, j, stage, str(n), method) not in done
             ]
     return pending
 
@@ -321,8 +355,9 @@ def select_rows(
     method: str,
 ) -> list[dict[str, str]]:
     """The rows of one configuration (a CSV may hold several): those problems, plan indices
-    below ``plans``, those particle counts, that seed and method; grouped by problem in the
-    order of ``problems`` (a resumed CSV may have them in any order)."""
+    below ``plans``, those particle counts, that seed and method (the ablation's rows too,
+    where there are any); grouped by problem in the order of ``problems`` (a resumed CSV may
+    have them in any order)."""
     counts = {str(n) for n in particles}
     order = {name: k for k, name in enumerate(problems)}
     selected = [
@@ -334,6 +369,15 @@ def select_rows(
         and (r["stage"] == NOMINAL or (r["particles"] in counts and r["method"] == method))
     ]
     return sorted(selected, key=lambda r: order[r["problem"]])
+
+
+#: How a progress line names a repair of each stage.
+_STAGE_WHAT = {REPAIRED: "repaired", ABLATION: "repaired without fixtures"}
+
+
+def _repair_stages(ablation: bool) -> tuple[str, ...]:
+    """The stages of the repairs of each nominal plan and particle count, in order."""
+    return (REPAIRED, ABLATION) if ablation else (REPAIRED,)
 
 
 def _key(*values: Any) -> tuple[str, ...]:
@@ -387,8 +431,11 @@ def _repair_row(
     workers: int,
     base: dict[str, Any],
     digest: str,
+    *,
+    stage: str = REPAIRED,
 ) -> dict[str, Any]:
-    """One repair as a row; the repaired actions ride along under ``_actions`` (not a column)."""
+    """One repair as a row of ``stage`` (``repaired``, or ``ablation``: the repair without
+    fixtures); the repaired actions ride along under ``_actions`` (not a column)."""
     started = time.perf_counter()
     try:
         result = repair_plan(
@@ -399,11 +446,12 @@ def _repair_row(
             method=method,
             workers=workers,
             timeout=timeout,
+            fixtures=stage != ABLATION,
         )
     except ValueError as error:  # recorded, so that one bad repair does not end a long sweep
         return _row(
             base,
-            stage=REPAIRED,
+            stage=stage,
             particles=count,
             method=method,
             status=ERROR,
@@ -415,7 +463,7 @@ def _repair_row(
     stats = result.stats()
     return _row(
         base,
-        stage=REPAIRED,
+        stage=stage,
         particles=count,
         method=method,
         status=result.status,
@@ -434,8 +482,9 @@ def _repair_row(
 # -- summaries -----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SummaryRow:
-    """Aggregate of one problem's nominal rows (``particles`` None) or of its repairs with one
-    particle count, over the plans.
+    """Aggregate of one problem's nominal rows (``particles`` None) or of its repairs of one
+    ``stage`` (``repaired``, or ``ablation``: without fixtures) with one particle count, over
+    the plans.
 
     ``plans`` counts the rows; ``solved`` those with a plan (nominal: found; repaired: the
     repair succeeded). ``reliability`` is the mean rate over the solved, evaluated rows with
@@ -459,25 +508,28 @@ class SummaryRow:
     fixtures: float
     statuses: tuple[tuple[str, int], ...]
     failures: tuple[int, ...] = (0, 0, 0, 0)
+    stage: str = REPAIRED
 
 
 def summarize(rows: Sequence[dict[str, str]]) -> list[SummaryRow]:
-    """Aggregate CSV rows per problem: the nominal plans, then each particle count (ascending).
+    """Aggregate CSV rows per problem: the nominal plans, then each particle count (ascending):
+    its repairs, then its repairs without fixtures (where ``rows`` has any).
 
     Rows of every seed and method in ``rows`` are pooled; filter them first to separate them.
     """
     out: list[SummaryRow] = []
     for problem in dict.fromkeys(r["problem"] for r in rows):
         mine = [r for r in rows if r["problem"] == problem]
-        groups: list[tuple[int | None, list[dict[str, str]]]] = [
-            (None, [r for r in mine if r["stage"] == NOMINAL])
+        groups: list[tuple[int | None, str, list[dict[str, str]]]] = [
+            (None, NOMINAL, [r for r in mine if r["stage"] == NOMINAL])
         ]
-        counts = sorted({int(r["particles"]) for r in mine if r["stage"] == REPAIRED})
-        groups += [
-            (n, [r for r in mine if r["stage"] == REPAIRED and r["particles"] == str(n)])
-            for n in counts
-        ]
-        for count, group in groups:
+        counts = sorted({int(r["particles"]) for r in mine if r["stage"] != NOMINAL})
+        for n in counts:
+            for stage in (REPAIRED, ABLATION):
+                group = [r for r in mine if r["stage"] == stage and r["particles"] == str(n)]
+                if group:
+                    groups.append((n, stage, group))
+        for count, stage, group in groups:
             solved = [r for r in group if r["status"] == "solved"]
             rates = [float(r["reliability"]) for r in solved if r["reliability"] != ""]
             others: dict[str, int] = {}
@@ -502,8 +554,23 @@ def summarize(rows: Sequence[dict[str, str]]) -> list[SummaryRow]:
                         sum(int(r[kind]) for r in solved if r["reliability"] != "")
                         for kind in FAILURE_KINDS
                     ),
+                    stage=stage,
                 )
             )
+    return out
+
+
+def fixture_shares(summary: Sequence[SummaryRow]) -> list[tuple[str, int, float, float]]:
+    """The fixtures' own share of the repairs' gain: per problem and particle count whose
+    repairs and repairs without fixtures were both evaluated, ``(problem, particles, repaired
+    mean reliability, ablation mean reliability)``; the share is the difference of the two."""
+    ablations = {(s.problem, s.particles): s for s in summary if s.stage == ABLATION}
+    out = []
+    for s in summary:
+        other = ablations.get((s.problem, s.particles))
+        if s.stage == REPAIRED and other is not None and s.evaluated and other.evaluated:
+            assert s.particles is not None
+            out.append((s.problem, s.particles, s.reliability, other.reliability))
     return out
 
 
@@ -511,7 +578,9 @@ def markdown_table(summary: Sequence[SummaryRow]) -> str:
     """The summary as a Markdown table: one line for the nominal plans of each problem, one
     per particle count of its repairs. Reliability is in percent, mean (min-max over plans);
     the failed rollouts are summed over plans, by kind: goal missed / an action failed (e.g.
-    the paddle put down on a part) / not at rest / off the table."""
+    the paddle put down on a part) / not at rest / off the table. The repairs without
+    fixtures (stage ``ablation``) are labelled ``repaired, no fixtures``; when there are any, a
+    second table gives the fixtures' own share (:func:`fixture_shares`) in points."""
     lines = [
         "| problem | plans | particles | solved | reliability, mean (min–max) | time (s) "
         "| plan length | fixtures placed | failed rollouts: goal / action / rest / off |",
@@ -526,13 +595,27 @@ def markdown_table(summary: Sequence[SummaryRow]) -> str:
             rel = f"{100 * s.reliability:.1f} % ({100 * s.low:.1f}–{100 * s.high:.1f})"
         else:
             rel = "—"
+        label = "nominal" if nominal else ABLATION_LABEL if s.stage == ABLATION else "repaired"
         lines.append(
-            f"| {s.problem} | {'nominal' if nominal else 'repaired'} "
+            f"| {s.problem} | {label} "
             f"| {'—' if nominal else s.particles} | {solved} | {rel} "
             f"| {_fmt(s.seconds, '.1f')} | {_fmt(s.length, '.1f')} "
             f"| {'—' if nominal else _fmt(s.fixtures, '.1f')} "
             f"| {' / '.join(map(str, s.failures)) if s.evaluated else '—'} |"
         )
+    shares = fixture_shares(summary)
+    if shares:
+        lines += [
+            "",
+            "| problem | particles | repaired, mean | repaired, no fixtures, mean "
+            "| fixtures' own share (points) |",
+            "|---|---|---|---|---|",
+        ]
+        for problem, count, repaired, ablation in shares:
+            lines.append(
+                f"| {problem} | {count} | {100 * repaired:.1f} % | {100 * ablation:.1f} % "
+                f"| {100 * (repaired - ablation):+.1f} |"
+            )
     return "\n".join(lines)
 
 
@@ -554,11 +637,12 @@ def plot_fixture_experiment(rows: Sequence[dict[str, str]], output_dir: Path) ->
 def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path) -> Path:
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4))
-    width = 0.38
+    ablated = any(s.stage == ABLATION for s in summary)
+    width = 0.27 if ablated else 0.38
     used: set[int] = set()
     for i, problem in enumerate(problems):
         nominal = next(s for s in summary if s.problem == problem and s.particles is None)
-        repaired = [s for s in summary if s.problem == problem and s.particles is not None]
+        repaired = [s for s in summary if s.problem == problem and s.stage == REPAIRED]
         # The thesis's overview (Figure 4-14) used 150 particles; else the largest count run.
         best = next((s for s in repaired if s.particles == 150), repaired[-1] if repaired else None)
         if best is not None:
@@ -566,7 +650,22 @@ def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path
         if nominal.solved == 0:
             ax.text(i, 2, "no nominal plan", ha="center", va="bottom", fontsize=8)
             continue
-        for offset, s, color in ((-width / 2, nominal, NOMINAL_COLOR), (width / 2, best, COLOR)):
+        bars = [(nominal, NOMINAL_COLOR), (best, COLOR)]
+        if ablated:  # the same repairs without fixtures, beside them
+            without = next(
+                (
+                    s
+                    for s in summary
+                    if s.problem == problem
+                    and s.stage == ABLATION
+                    and best is not None
+                    and s.particles == best.particles
+                ),
+                None,
+            )
+            bars.append((without, ABLATION_COLOR))
+        for k, (s, color) in enumerate(bars):
+            offset = (k - (len(bars) - 1) / 2) * width
             if s is None or not s.evaluated:
                 ax.text(i + offset, 2, "not evaluated", rotation=90, ha="center", fontsize=7)
                 continue
@@ -579,11 +678,14 @@ def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path
                 capsize=3,
             )
     counts = ", ".join(str(n) for n in sorted(used))
+    handles = [
+        Patch(color=NOMINAL_COLOR, label="nominal (deterministic)"),
+        Patch(color=COLOR, label=f"repaired ({counts} particles)"),
+    ]
+    if ablated:
+        handles.append(Patch(color=ABLATION_COLOR, label=f"{ABLATION_LABEL} (same repairs)"))
     ax.legend(
-        handles=[
-            Patch(color=NOMINAL_COLOR, label="nominal (deterministic)"),
-            Patch(color=COLOR, label=f"repaired ({counts} particles)"),
-        ],
+        handles=handles,
         fontsize=8,
         loc="upper right",
     )
@@ -601,7 +703,8 @@ def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path
 def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
     plt = pyplot()
     nominal = rows[0]
-    repaired = [s for s in rows if s.particles is not None]
+    repaired = [s for s in rows if s.stage == REPAIRED]
+    ablation = [s for s in rows if s.stage == ABLATION and s.evaluated]
     fig, (ax_rel, ax_time) = plt.subplots(1, 2, figsize=(11, 4))
     if nominal.solved == 0:
         for ax in (ax_rel, ax_time):
@@ -636,12 +739,29 @@ def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
             color=COLOR,
             label="repaired (mean, min–max)",
         )
-    for s in repaired:
+    if ablation:
+        xs = [s.particles for s in ablation]
+        ys = [100 * s.reliability for s in ablation]
+        ax_rel.errorbar(
+            xs,
+            ys,
+            yerr=[
+                [y - 100 * s.low for y, s in zip(ys, ablation, strict=True)],
+                [100 * s.high - y for y, s in zip(ys, ablation, strict=True)],
+            ],
+            marker="s",
+            ls="--",
+            capsize=3,
+            color=ABLATION_COLOR,
+            label=f"{ABLATION_LABEL} (mean, min–max)",
+        )
+    for s in [s for s in rows if s.stage != NOMINAL]:
         failed = s.plans - s.solved
         if failed:
+            without = s.stage == ABLATION
             ax_rel.annotate(
-                f"{failed}/{s.plans} repairs\nnot solved",
-                (s.particles, 2),
+                f"{failed}/{s.plans} repairs\n{'without fixtures ' if without else ''}not solved",
+                (s.particles, 14 if without else 2),
                 ha="center",
                 fontsize=7,
                 color="tab:red",
@@ -654,7 +774,7 @@ def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
     ax_rel.set_xlabel("particles of the repair's belief")
     ax_rel.set_ylabel("% of rollouts reaching the goal")
     ax_rel.set_title(f"{problem}: reliability", fontsize=10)
-    if nominal.evaluated or shown:
+    if nominal.evaluated or shown or ablation:
         ax_rel.legend(fontsize=7, loc="upper left")
     timed = [s for s in repaired if s.solved]
     if timed:

@@ -14,6 +14,10 @@ holds more) with the runs that found no plan marked, and :func:`transition_markd
 :func:`search_markdown` give those rows as a table. :func:`pending_transition_runs` and
 :func:`pending_searches` list what a call would measure, for an estimate of its duration
 (:mod:`arrange_up.experiments.costs`). Sizes scale down by arguments (the CLI's flags).
+
+Both drive every problem by ``controller`` (a controller kind at its defaults) or, when it is
+``None``, by its own controller; every row records the kind in its ``controller`` column, and
+the CSV's settings record it, so a rerun under another controller is refused.
 """
 
 from __future__ import annotations
@@ -29,14 +33,15 @@ from matplotlib.patches import Patch
 
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
+from arrange_up.experiments.problems import controller_setting, driven_problems
 from arrange_up.figures.backend import pyplot
-from arrange_up.io.domains import load
 from arrange_up.parallel import available_cores
 from arrange_up.planning.planner import plan
 from arrange_up.transitions import available
 
 TRANSITION_FIELDS = [
     "problem",
+    "controller",
     "planner",
     "semantics",
     "particles",
@@ -59,6 +64,7 @@ SEARCH_FIELDS = [
     "heuristic",
     "domination",
     "problem",
+    "controller",
     "semantics",
     "status",
     "solved",
@@ -105,23 +111,31 @@ def transition_comparison(
     max_nodes: int = 5000,
     timeout: float | None = None,
     workers: int | None = None,
+    controller: str | None = None,
     progress: Progress | None = None,
     measured: Measured | None = None,
 ) -> Path:
     """Run (or resume) the transition comparison; returns the CSV path. See module doc.
 
-    ``progress`` gets a line as each planning run or evaluation starts, ``measured`` each row
-    as it is written; the PNG shows the rows of ``problems``, ``planners`` and runs below
-    ``runs``."""
+    ``controller`` (``"compliant"`` or ``"servo"``) drives every problem by that controller
+    kind at its defaults, ``None`` by its own. ``progress`` gets a line as each planning run
+    or evaluation starts, ``measured`` each row as it is written; the PNG shows the rows of
+    ``problems``, ``planners`` and runs below ``runs``."""
     workers = workers or available_cores()
     planners = list(planners or default_planners())
     path = Path(output_dir) / "transition-comparison.csv"
     say = progress or (lambda _msg: None)
-    settings = {"rollouts": rollouts, "max_nodes": max_nodes, "timeout": timeout}
+    loaded = driven_problems(problems, controller)
+    settings = {
+        "rollouts": rollouts,
+        "max_nodes": max_nodes,
+        "timeout": timeout,
+        "controller": controller_setting(loaded),
+    }
     with CsvAppender(path, TRANSITION_FIELDS, key=_TRANSITION_KEY, settings=settings) as write:
         done = write.done  # grows as rows are written: a repeated planner is measured once
         for name in problems:
-            problem = load(name)
+            problem = loaded[name]
             for planner in planners:
                 for run in range(runs):
                     if (name, planner.label, str(run)) in done:
@@ -140,6 +154,7 @@ def transition_comparison(
                     seconds = time.perf_counter() - start
                     row: dict[str, Any] = {
                         "problem": name,
+                        "controller": problem.controller.kind.value,
                         "planner": planner.label,
                         "semantics": planner.semantics,
                         "particles": result.particles,
@@ -216,20 +231,25 @@ def search_table(
     weight: float = 1.0,
     timeout: float | None = None,
     workers: int | None = None,
+    controller: str | None = None,
     progress: Progress | None = None,
     measured: Measured | None = None,
 ) -> Path:
     """Run (or resume) the search table (A*, weight 1, as in the thesis); returns the CSV.
 
-    ``progress`` gets a line as each search starts, ``measured`` each row as it is written;
-    the PNG shows the rows of ``problems`` and ``semantics``."""
+    ``controller`` (``"compliant"`` or ``"servo"``) drives every problem by that controller
+    kind at its defaults, ``None`` by its own. ``progress`` gets a line as each search
+    starts, ``measured`` each row as it is written; the PNG shows the rows of ``problems`` and
+    ``semantics``."""
     path = Path(output_dir) / "search-table.csv"
     say = progress or (lambda _msg: None)
+    loaded = driven_problems(problems, controller)
     settings = {
         "particles": particles,
         "max_nodes": max_nodes,
         "weight": weight,
         "timeout": timeout,
+        "controller": controller_setting(loaded),
     }
     with CsvAppender(path, SEARCH_FIELDS, key=_SEARCH_KEY, settings=settings) as write:
         done = write.done  # grows as rows are written: a repeated problem is measured once
@@ -242,7 +262,7 @@ def search_table(
                     say(f"{label} domination={key[1]} {name}")
                     start = time.perf_counter()
                     result = plan(
-                        load(name),
+                        loaded[name],
                         semantics=semantics,
                         particles=particles,
                         seed=0,
@@ -258,6 +278,7 @@ def search_table(
                         "heuristic": heuristic,
                         "domination": key[1],
                         "problem": name,
+                        "controller": loaded[name].controller.kind.value,
                         "semantics": semantics,
                         "status": result.status,
                         "solved": int(result.solved),

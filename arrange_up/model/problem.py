@@ -303,6 +303,21 @@ class ArrangementProblem:
         return self.of_kind(ObjectKind.OBSTACLE)
 
 
+def driven_by(problem: ArrangementProblem, kind: ControllerKind | str) -> ArrangementProblem:
+    """``problem`` driven by a controller of ``kind`` (``"compliant"`` or ``"servo"``):
+    ``problem`` itself when its controller already is of that kind (its own gains kept),
+    else ``problem`` with that controller at its defaults. Raises ``ValueError`` for an
+    unknown kind."""
+    try:
+        kind = ControllerKind(kind)
+    except ValueError:
+        known = ", ".join(k.value for k in ControllerKind)
+        raise ValueError(f"unknown controller kind {kind!r}; expected one of {known}") from None
+    if problem.controller.kind is kind:
+        return problem
+    return dataclasses.replace(problem, controller=Controller(kind=kind))
+
+
 def problem_hash(problem: ArrangementProblem) -> str:
     """A content hash of what the planner sees: ``"sha256:<hex>"``.
 

@@ -197,7 +197,9 @@ class RepairResult:
     ``actions`` is the repaired plan when ``status == "solved"``, else ``None`` (``partial``
     holds what was repaired before the failure). ``steps`` has one record per nominal action
     handled (the failing one last). ``beliefs`` holds the particle belief before the first
-    action and after each step.
+    action and after each step. ``fixtures`` is ``False`` for the fixtures' ablation (no
+    placement was a candidate); the plan file's ``repair`` object then says
+    ``"fixtures": false`` (it names no ``fixtures`` key otherwise).
     """
 
     status: RepairStatus
@@ -212,6 +214,7 @@ class RepairResult:
     simulations: int = 0
     partial: tuple[Action, ...] = ()
     beliefs: tuple[ParticleBelief, ...] = field(default=(), repr=False, compare=False)
+    fixtures: bool = True
 
     @property
     def solved(self) -> bool:
@@ -244,11 +247,17 @@ class RepairResult:
             "method": self.method,
             "particles": self.particles,
             "seed": self.seed,
-            "multipliers": list(MULTIPLIERS),
-            "grid_step": GRID_STEP,
-            "nominal": [action_to_json(a, problem.units) for a in self.nominal],
-            "steps": steps,
         }
+        if not self.fixtures:  # absent for a full repair: its record is as it always was
+            data["fixtures"] = False
+        data.update(
+            {
+                "multipliers": list(MULTIPLIERS),
+                "grid_step": GRID_STEP,
+                "nominal": [action_to_json(a, problem.units) for a in self.nominal],
+                "steps": steps,
+            }
+        )
         if self.reason:
             data["reason"] = self.reason
         return data
@@ -273,7 +282,8 @@ def plan_groups(
 
     For a repaired plan (its document has a ``repair`` object) ``nominal`` is the nominal plan
     recorded there, ``groups[k]`` the actions that replaced nominal action ``k`` and
-    ``settings`` the repair's ``particles``, ``seed`` and ``method``. For any other plan the
+    ``settings`` the repair's ``particles``, ``seed``, ``method`` and, for the fixtures'
+    ablation, ``fixtures`` (false). For any other plan the
     plan is its own nominal plan, one action per group, and ``settings`` is empty.
     """
     actions = tuple(actions)
@@ -293,5 +303,7 @@ def plan_groups(
             groups.append(actions[start:stop])
     except (KeyError, TypeError, ValueError) as error:
         raise PlanFileError(f"repair: malformed repair record: {error}") from None
-    settings = {key: repair[key] for key in ("particles", "seed", "method") if key in repair}
+    settings = {
+        key: repair[key] for key in ("particles", "seed", "method", "fixtures") if key in repair
+    }
     return nominal, tuple(groups), settings

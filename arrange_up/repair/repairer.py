@@ -149,6 +149,7 @@ def repair_plan(
     workers: int = 1,
     progress: ProgressCallback | None = None,
     timeout: float | None = None,
+    fixtures: bool = True,
 ) -> RepairResult:
     """Repair the nominal plan ``actions`` with fixtures (thesis Figure 4-7; module docstring).
 
@@ -169,6 +170,12 @@ def repair_plan(
         ``elapsed`` and, when done, ``choice`` (a short text).
     timeout
         Wall-clock seconds; checked between batches of candidates (status ``"timeout"``).
+    fixtures
+        ``False``: the ablation of the fixtures. The repair runs as with fixtures but no
+        placement is ever a candidate (every push's placement grid is empty), so each push
+        keeps only the no-fixture candidates: the cleared approach's back-off and the push
+        multipliers. Comparing its plan with the full repair's measures what the fixtures
+        themselves bring. Recorded as ``fixtures`` in the result and its plan document.
 
     A repaired plan must reach the goal in the deterministic semantics: one that does not (an
     empty nominal plan, or one short of the goal that no fixture saves) ends with status
@@ -179,7 +186,7 @@ def repair_plan(
     started = time.monotonic()
     deadline = None if timeout is None else started + timeout
     actions = tuple(actions)
-    repairer = Repairer(problem, particles, seed, method, workers, deadline)
+    repairer = Repairer(problem, particles, seed, method, workers, deadline, fixtures=fixtures)
     records: list[StepRecord] = []
     out: list[Action] = []
 
@@ -197,6 +204,7 @@ def repair_plan(
             simulations=repairer.simulations,
             partial=tuple(out),
             beliefs=tuple(beliefs),
+            fixtures=fixtures,
         )
 
     try:
@@ -284,7 +292,8 @@ def step_scores(
     step number its ``repair.steps`` records, whose nominal plan, particles, seed and method
     are then the defaults, and whose earlier steps' repaired actions take the belief to the
     step, so the scores are the ones the repair saw (up to the rounding of numbers in the plan
-    file). Without a repair record the defaults are 150 particles, seed 0, enhanced.
+    file). Without a repair record the defaults are 150 particles, seed 0, enhanced; a repair
+    record of the fixtures' ablation (``fixtures`` false) scores no placement.
 
     Raises ``ValueError`` when ``step`` is out of range or not a push, or when the belief
     cannot be propagated to it.
@@ -303,7 +312,8 @@ def step_scores(
     particles = particles if particles is not None else int(settings.get("particles", 150))
     seed = seed if seed is not None else int(settings.get("seed", 0))
     method = method if method is not None else str(settings.get("method", "enhanced"))
-    repairer = Repairer(problem, particles, seed, method, workers, None)
+    fixtures = settings.get("fixtures", True) is not False
+    repairer = Repairer(problem, particles, seed, method, workers, None, fixtures=fixtures)
     try:
         states = repairer.nominal_states(nominal)
         belief = repairer.initial_belief()
@@ -323,7 +333,8 @@ class _OutOfTime(Exception):
 
 class Repairer:
     """State shared by the steps of one repair: the problem, the particle semantics (its
-    propagation, common random numbers and worker pool) and the deadline."""
+    propagation, common random numbers and worker pool) and the deadline. With
+    ``fixtures=False`` no placement is a candidate (see :func:`repair_plan`)."""
 
     def __init__(
         self,
@@ -333,6 +344,8 @@ class Repairer:
         method: str,
         workers: int,
         deadline: float | None,
+        *,
+        fixtures: bool = True,
     ) -> None:
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
@@ -348,6 +361,7 @@ class Repairer:
         self.method = method
         self.workers = workers
         self.deadline = deadline
+        self.fixtures = fixtures
         self.semantics = ParticleSemantics(problem, particles=particles, seed=seed, workers=workers)
         self.checker = self.semantics.checker
         self.frame = self.semantics.frame
@@ -638,8 +652,10 @@ class _OneStepProblem:
 
     def grid(self, swaths: tuple[Swath, ...]) -> list[tuple[str, Pose, bool]]:
         """The placement grid (``(fixture, pose, allowed)``); for the enhanced method only the
-        placements whose footprint meets a swath."""
+        placements whose footprint meets a swath; empty without fixtures."""
         r, belief = self.repairer, self.belief
+        if not r.fixtures:
+            return []
         grid = grid_placements(
             r.problem, r.checker, r.intervals(belief), belief.names(), self.pushed(1.0)
         )

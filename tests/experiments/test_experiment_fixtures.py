@@ -20,7 +20,7 @@ from arrange_up.experiments.fixtures import (
     summarize,
 )
 
-TINY = {"plans": 1, "particles": (3, 5), "rollouts": 5, "workers": 1}
+TINY = {"plans": 1, "particles": (3, 5), "rollouts": 5, "workers": 1, "ablation": False}
 
 
 def rows(path):
@@ -169,11 +169,14 @@ def test_cli_writes_csv_pngs_and_table_and_resumes(tmp_path):
     assert [(r["problem"], r["stage"], r["status"]) for r in table] == [
         ("down-push", "nominal", "solved"),
         ("down-push", "repaired", "solved"),
+        ("down-push", "ablation", "solved"),  # on by default
     ]
     for name in ("overview", "down-push"):
         assert (tmp_path / f"fixtures-{name}.png").stat().st_size > 0
     assert "| down-push | nominal | — | 1/1 |" in result.output
     assert "| down-push | repaired | 3 | 1/1 |" in result.output
+    assert "| down-push | repaired, no fixtures | 3 | 1/1 |" in result.output
+    assert "fixtures' own share" in result.output
     again = invoke(*args)
     assert again.exit_code == 0 and rows(tmp_path / "fixtures.csv") == table
 
@@ -203,3 +206,70 @@ def test_cli_refuses_a_foreign_csv_with_exit_2(tmp_path):
         main, ["experiment", "fixtures", "--problems", "down-push", "--output-dir", str(tmp_path)]
     )
     assert result.exit_code == 2 and "another output directory" in result.output
+
+
+# -- the fixtures' ablation ----------------------------------------------------------------------
+def test_the_ablation_rows_are_the_same_repairs_without_fixtures(tmp_path, monkeypatch):
+    calls = []
+    repair_plan = experiment.repair_plan
+
+    def recording(problem, actions, **kwargs):
+        calls.append((kwargs["particles"], kwargs["seed"], kwargs["method"], kwargs["fixtures"]))
+        return repair_plan(problem, actions, **kwargs)
+
+    monkeypatch.setattr(experiment, "repair_plan", recording)
+    # seed 2, 5 particles: the full repair of down-push places the bar
+    args = {**TINY, "particles": (5,), "seed": 2}
+    path = fixture_experiment(tmp_path, problems=("down-push",), **{**args, "ablation": True})
+    nominal, repaired, ablation = rows(path)
+    assert [r["stage"] for r in (nominal, repaired, ablation)] == [
+        "nominal",
+        "repaired",
+        "ablation",
+    ]
+    assert calls == [(5, 2, "enhanced", True), (5, 2, "enhanced", False)]
+    assert int(repaired["fixtures_placed"]) >= 1
+    assert ablation["status"] == "solved" and ablation["fixtures_placed"] == "0"
+    assert (ablation["particles"], ablation["method"]) == ("5", "enhanced")
+    assert ablation["plan_hash"] == nominal["plan_hash"]
+    assert int(ablation["rollouts"]) == 5  # evaluated on the same rollouts
+    assert int(ablation["plan_length"]) == int(nominal["plan_length"])  # no place, no pick
+
+    summary = summarize(read_rows(path))
+    assert [(s.stage, s.particles) for s in summary] == [
+        ("nominal", None),
+        ("repaired", 5),
+        ("ablation", 5),
+    ]
+    share = float(repaired["reliability"]) - float(ablation["reliability"])
+    ((problem, count, with_fixtures, without),) = experiment.fixture_shares(summary)
+    assert (problem, count) == ("down-push", 5)
+    assert with_fixtures - without == pytest.approx(share)
+    table = markdown_table(summary)
+    assert "| down-push | repaired, no fixtures | 5 | 1/1 |" in table
+    assert f"| {100 * share:+.1f} |" in table
+    assert (tmp_path / "fixtures-down-push.png").stat().st_size > 0
+
+    # Without ablation rows the table is as it always was: no share table.
+    assert "own share" not in markdown_table([s for s in summary if s.stage != "ablation"])
+
+
+def test_turning_the_ablation_on_later_measures_only_its_rows(tmp_path, monkeypatch):
+    args = {**TINY, "particles": (3,), "rollouts": 0}
+    path = fixture_experiment(tmp_path, problems=("down-push",), **args)
+    first = rows(path)
+    assert [r["stage"] for r in first] == ["nominal", "repaired"]
+    assert experiment.pending_rows(
+        tmp_path, problems=["down-push"], plans=1, particles=[3], seed=0, method="enhanced"
+    ) == [("down-push", 3, "ablation")]
+    calls = []
+    repair_plan = experiment.repair_plan
+
+    def recording(problem, actions, **kwargs):
+        calls.append(kwargs["fixtures"])
+        return repair_plan(problem, actions, **kwargs)
+
+    monkeypatch.setattr(experiment, "repair_plan", recording)
+    fixture_experiment(tmp_path, problems=("down-push",), **{**args, "ablation": True})
+    assert calls == [False]
+    assert rows(path)[:2] == first and rows(path)[2]["stage"] == "ablation"

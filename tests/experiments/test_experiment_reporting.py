@@ -52,6 +52,11 @@ def test_costs_come_from_the_measured_table_and_scale_with_the_node_limit():
     assert costs.search_cost("cbst", "blocks-2", 0, True, 5000) == 0.04
     assert costs.fixture_cost("down-push", 10, 0) == pytest.approx(1.3)
     assert costs.fixture_cost("nowhere", None, 10) is None
+    # a repair without fixtures has its own measured cost, a small share of a full repair's
+    ablation = costs.fixture_cost("down-push", 10, 0, fixtures=False)
+    assert ablation == pytest.approx(10 * costs.ABLATION_SECONDS_PER_PARTICLE["down-push"])
+    assert 0 < ablation < costs.fixture_cost("down-push", 10, 0)
+    assert set(costs.ABLATION_SECONDS_PER_PARTICLE) == set(costs.REPAIR_SECONDS_PER_PARTICLE)
 
 
 def test_the_estimate_says_what_it_does_not_know():
@@ -80,8 +85,19 @@ def test_pending_measurements_leave_out_what_the_csv_holds(tmp_path):
         pending_rows(
             tmp_path, problems=["down-push"], plans=2, particles=[10, 40], seed=0, method="enhanced"
         )
-        == [("down-push", None), ("down-push", 10), ("down-push", 40)] * 2
+        == [
+            ("down-push", None, "nominal"),
+            ("down-push", 10, "repaired"),
+            ("down-push", 10, "ablation"),
+            ("down-push", 40, "repaired"),
+            ("down-push", 40, "ablation"),
+        ]
+        * 2
     )
+    assert pending_rows(
+        tmp_path, problems=["down-push"], plans=1, particles=[10], seed=0, method="enhanced",
+        ablation=False,
+    ) == [("down-push", None, "nominal"), ("down-push", 10, "repaired")]  # fmt: skip
 
 
 def test_tables_and_plots_show_only_the_rows_asked_for_with_node_limits(tmp_path):

@@ -292,6 +292,55 @@ def test_belief_intervals_span_angles_the_short_way(tz):
     assert repairer.intervals(belief).get("Z").half[2] <= math.radians(1.0) + 1e-9
 
 
+# -- the fixtures' ablation -----------------------------------------------------------------
+def test_the_ablation_places_no_fixture_and_keeps_the_bare_candidates(tmp_path, down_push):
+    nominal = rp.nominal_plans(down_push, 1, seed=0)[0]
+    # with 5 particles and seed 2 the full repair places the bar
+    full = rp.repair_plan(down_push, nominal, particles=5, seed=2, workers=1)
+    assert full.solved and full.steps[0].fixture is not None
+    ablation = rp.repair_plan(down_push, nominal, particles=5, seed=2, workers=1, fixtures=False)
+    assert ablation.solved and not ablation.fixtures and full.fixtures
+    assert not any(isinstance(a, Place | Pick) for a in ablation.actions)
+    (record,) = ablation.steps
+    assert (
+        record.fixture is None
+        and record.placements == 0
+        and ablation.stats()["fixtures_placed"] == 0
+    )
+    # the same no-fixture candidates as the full repair's (same noise), the best of them kept
+    scores = rp.step_scores(down_push, nominal, 1, particles=5, seed=2)
+    bare = min(
+        (c for c in scores.refined if c.fixture is None and c.valid),
+        key=lambda c: (c.distance, c.multiplier),
+    )
+    assert (record.multiplier, record.distance) == (bare.multiplier, bare.distance)
+    assert record.backoff == scores.backoff
+    # the plan document says so; a full repair's names no fixtures key (as it always was)
+    document = ablation.document(down_push)
+    assert document["repair"]["fixtures"] is False
+    assert "fixtures" not in full.document(down_push)["repair"]
+    path = write_json_atomic(tmp_path / "ablation.json", document)
+    actions, read = read_plan(path, down_push)
+    _, _, settings = rp.plan_groups(down_push, actions, read)
+    assert settings["fixtures"] is False
+    # its heatmap scores are the ablation's: no placement
+    again = rp.step_scores(down_push, actions, 1, document=read)
+    assert [c.fixture for c in again.placements] == [None]
+
+
+def test_cli_repair_no_fixtures(tmp_path):
+    out = tmp_path / "ablation.json"
+    args = ["repair", "down-push", "--particles", "5", "--seed", "2", "--workers", "1"]
+    result = CliRunner().invoke(
+        main, [*args, "--no-fixtures", "-o", str(out)], catch_exceptions=False
+    )
+    assert result.exit_code == 0, result.output
+    assert "no fixtures" in result.output and "0 fixtures placed" in result.output
+    assert json.loads(out.read_text())["repair"]["fixtures"] is False
+    helped = CliRunner().invoke(main, ["repair", "--help"])
+    assert "--no-fixtures" in helped.output and "ablation" in helped.output
+
+
 # -- plan files, CLI, UP, heatmap ---------------------------------------------------------------
 def test_plan_file_round_trip_and_heatmap_scores(tmp_path, down_push, down_repair):
     path = write_json_atomic(tmp_path / "fixed.json", down_repair.document(down_push))

@@ -1,0 +1,28 @@
+"""The problems an experiment measures, driven by the controller it was asked for, and how that
+controller is recorded (a ``controller`` column in every row and a ``controller`` setting of the
+CSV, so that rows measured under different controllers are never mixed)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from arrange_up.io.domains import load
+from arrange_up.model.problem import ArrangementProblem, driven_by
+
+__all__ = ["controller_setting", "driven_problems"]
+
+
+def driven_problems(names: Sequence[str], controller: str | None) -> dict[str, ArrangementProblem]:
+    """Each problem of ``names`` (loaded once, in order), driven by a ``controller`` kind at its
+    defaults (:func:`~arrange_up.model.problem.driven_by`), or by its own controller when
+    ``controller`` is ``None``. Raises ``ValueError`` for an unknown kind."""
+    return {
+        name: load(name) if controller is None else driven_by(load(name), controller)
+        for name in dict.fromkeys(names)
+    }
+
+
+def controller_setting(problems: Mapping[str, ArrangementProblem]) -> str:
+    """The CSV setting naming the controller kind the problems are driven by (the kinds in
+    alphabetical order, comma-separated, if they differ)."""
+    return ",".join(sorted({problem.controller.kind.value for problem in problems.values()}))
