@@ -6,7 +6,8 @@ A page is read as a sequence of fenced blocks:
   ``bash``) is a command; ``&&`` chains commands; ``# ...`` ends it as a comment. The lines
   that follow a command in a ``console`` block, up to the next ``$``, are its expected output;
   a line ``…`` among them means "the output continues", and only the lines before it are
-  compared.
+  compared. A command line that ends with the comment ``# exit status N`` is expected to exit
+  with status N (a command that shows a failure); it must be a single command.
 * ``yaml`` (or any other) blocks with ``title="NAME"`` in their info string are files the
   reader saves: they are written to NAME before the next command runs.
 * ``python`` blocks are run as a script; a ``text`` block that follows one directly (only
@@ -14,7 +15,8 @@ A page is read as a sequence of fenced blocks:
 
 Everything runs in one temporary directory, in page order, so later commands see the files of
 earlier ones. ``arrange-up`` runs as ``python -m arrange_up`` with the interpreter and the
-package under test. A command that exits non-zero fails the page.
+package under test. A command that exits with another status than the page says (0 unless
+it says ``# exit status N``) fails the page.
 
 Printed output is compared after :func:`normalise`, which replaces what changes from run to
 run and machine to machine, and nothing else: elapsed seconds (``in 5.6 s``, ``, 1.4 s``) and
@@ -37,6 +39,8 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 
 FENCE = re.compile(r"^(?P<indent> *)```(?P<info>[^`]*)$")
 TITLE = re.compile(r'title="(?P<name>[^"]+)"')
+#: The comment that ends a command line expected to exit with a status other than 0.
+EXIT_STATUS = re.compile(r"#\s*exit status (?P<status>\d+)\s*$")
 
 #: What :func:`normalise` replaces, and why.
 NORMALISATIONS: tuple[tuple[re.Pattern[str], str], ...] = (
@@ -70,6 +74,7 @@ class Step:
     expected: list[str] | None = None  # the output the page shows, if it shows any
     continues: bool = False  # the page shows only the start of the output ("…")
     block: int = 0  # which fenced block (0-based) the step comes from
+    exit_status: int = 0  # the status the command must exit with
 
 
 @dataclass
@@ -123,8 +128,17 @@ def steps(page: Path) -> list[Step]:
         elif language == "console":
             for offset, line in enumerate(block.body, start=1):
                 if line.startswith("$ "):
-                    for command in _commands(line[2:]):
+                    commands = _commands(line[2:])
+                    status = EXIT_STATUS.search(line)
+                    if status and len(commands) != 1:
+                        raise AssertionError(
+                            f"{page}:{block.line + offset}: `# exit status` ends a line of "
+                            f"{len(commands)} commands; it is for a single command"
+                        )
+                    for command in commands:
                         found.append(Step(block.line + offset, "command", command, block=index))
+                    if status:
+                        found[-1].exit_status = int(status["status"])
                 elif found and found[-1].block == index and found[-1].kind == "command":
                     last = found[-1]
                     if line.strip() == "…":
@@ -227,11 +241,13 @@ def compare(page: Path, step: Step, output: str) -> None:
 
 
 def check_exit(page: Path, step: Step, result: subprocess.CompletedProcess[str]) -> None:
-    """Fail, with the command's output, if it exited non-zero."""
-    if result.returncode != 0:
+    """Fail, with the command's output, unless it exited with the status the page says (0
+    unless the line ends ``# exit status N``)."""
+    if result.returncode != step.exit_status:
+        expected = f" (the page says {step.exit_status})" if step.exit_status else ""
         raise AssertionError(
-            f"{page.name}:{step.line}: `{step.text[:200]}` exited {result.returncode}:\n"
-            + result.stdout[-4000:]
+            f"{page.name}:{step.line}: `{step.text[:200]}` exited {result.returncode}"
+            f"{expected}:\n" + result.stdout[-4000:]
         )
 
 
