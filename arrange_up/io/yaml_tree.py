@@ -81,7 +81,8 @@ class Unsupported(Exception):
 
 class YamlMap(dict):
     """A mapping with ``marks[key] = (key line, key column, value line, value column)``,
-    0-based, for each key written in it (keys merged in by ``<<`` have none)."""
+    0-based, for each key written in it (keys merged in by ``<<`` have none). Where an empty
+    value is written depends on the parser (readers point at its key instead)."""
 
     __slots__ = ("marks",)
 
