@@ -53,6 +53,7 @@ __all__ = [
     "MAX_FAST_DEPTH",
     "Document",
     "Duplicate",
+    "Refused",
     "Unsupported",
     "YamlMap",
     "YamlSeq",
@@ -70,13 +71,25 @@ _RARE = re.compile(
     "[^\n\r\x20-\x7e\xa0-\u2027\u202a-\ud7ff\ue000-\ufefe\uff00-\ufffd\U00010000-\U0010ffff]"
 )
 #: A libyaml syntax error is worded by ruamel reading the text up to this many characters past
-#: it (the whole text when ruamel's error is not clearly before the cut, see :func:`read`).
+#: it (the whole text when ruamel's error is not clearly before the cut, see
+#: :func:`_raise_ruamel_error`).
 _ERROR_PREFIX = 8192
 _CUT_MARGIN = 2048
 
 
 class Unsupported(Exception):
     """The libyaml reading does not take this document; ruamel reads it."""
+
+
+class Refused(Exception):
+    """libyaml refused the text: ``error`` is its ``MarkedYAMLError``; ``spans`` are the
+    ``(start, end)`` character ranges, one per collection open at the error, from the start of
+    its first child to the start of its last (empty when the text has anchors)."""
+
+    def __init__(self, error: Exception, spans: list[tuple[int, int]]) -> None:
+        super().__init__(str(error))
+        self.error = error
+        self.spans = spans
 
 
 class YamlMap(dict):
@@ -128,29 +141,55 @@ def read(text: str) -> Document | None:
     if CParser is not None:
         try:
             return read_libyaml(text)
-        except LibyamlMarkedError as error:
-            _raise_ruamel_error_near(text, error)
+        except Refused as refused:
+            _raise_ruamel_error(text, refused)
         except Exception:  # Unsupported, or anything unforeseen: the reference reading decides
             pass
     return read_ruamel(text)
 
 
-def _raise_ruamel_error_near(text: str, error: Any) -> None:
-    """Raise ruamel's error for a text libyaml refused, reading only the text up to a little
-    past libyaml's error when ruamel finds an error clearly before that cut (a streaming parser
-    finds the same first error in a text and in any prefix reaching well past it); return
-    (for a reading of the whole text) otherwise."""
-    mark = error.problem_mark or error.context_mark
-    if mark is None:
+def _raise_ruamel_error(text: str, refused: Refused) -> None:
+    """Raise ruamel's error for a text libyaml refused, found in a shorter text that ruamel
+    reads as it reads ``text`` up to the error; return (for a reading of the whole text) when
+    that cannot be trusted.
+
+    The shorter text ends a little past libyaml's error (a streaming parser finds the same first
+    error in a text and in any prefix reaching well past it: a cut is trusted when ruamel's
+    error lies clearly before it) and leaves out, in each collection open at the error, the
+    children between its first and its last (``refused.spans``): the parser is in the same state
+    after the first child as after any other, so it meets the last child, and the error, in the
+    same state. ruamel's places are mapped back to ``text``, and trusted only when ruamel's
+    error is on the line of libyaml's (or next to it).
+    """
+    mark = refused.error.problem_mark or refused.error.context_mark
+    if mark is None or "\r" in text:
         return
     cut = mark.index + _ERROR_PREFIX
-    if cut >= len(text):
-        return
+    spans = [(start, end) for start, end in refused.spans if end <= cut]
+    if cut >= len(text) and not spans:
+        return  # nothing to leave out: the whole text is read anyway
+    pieces, kept, removed, at = [], [], 0, 0
+    for start, end in spans:
+        pieces.append(text[at:start])
+        kept.append((start - removed, end - start))  # (start in the shorter text, length)
+        removed += end - start
+        at = end
+    pieces.append(text[at:cut])
+    shorter = "".join(pieces)
     try:
-        read_ruamel(text[:cut])
+        read_ruamel(shorter)
     except MarkedYAMLError as found:
         where = found.problem_mark or found.context_mark
-        if where is not None and where.index < cut - _CUT_MARGIN:
+        if where is None or (cut < len(text) and where.index >= len(shorter) - _CUT_MARGIN):
+            return
+        places = {id(place): place for place in (found.problem_mark, found.context_mark)}
+        for place in places.values():  # one mark may be both
+            if place is not None:
+                index = place.index + sum(length for start, length in kept if start <= place.index)
+                place.index = index
+                place.line = text.count("\n", 0, index)
+                place.column = index - (text.rfind("\n", 0, index) + 1)
+        if abs(where.line - mark.line) <= 1:  # libyaml puts an error at the end on a line after
             raise
     except Exception:  # the whole text decides
         pass
@@ -289,7 +328,8 @@ def _plain(text: str) -> tuple[Any, str]:
 class _Frame:
     """A mapping or list being read: its value, path, anchor, start and the key read last."""
 
-    __slots__ = ("anchor", "column", "first", "key", "line", "path", "value")
+    __slots__ = ("anchor", "column", "first", "first_child", "key", "last_child", "line", "path")
+    __slots__ += ("value",)
 
     def __init__(self, value: Any, path: str, anchor: str | None, line: int, column: int):
         self.value = value
@@ -299,20 +339,34 @@ class _Frame:
         self.column = column
         self.key: tuple[Any, str, str, int, int] | None = None  # value, tag, text, line, column
         self.first: dict[tuple[str, str], tuple[int, int]] = {}
+        # Where the first and the latest child (item, or key of a pair) start in the text.
+        self.first_child = self.last_child = -1
 
 
 def read_libyaml(text: str) -> Document | None:
     """``text`` read from libyaml's events into the tree ruamel's reading gives.
 
-    Raises :class:`Unsupported` for what it leaves to ruamel, libyaml's ``MarkedYAMLError``
-    for a text libyaml refuses, and ``ValueError`` for an integer too long to convert (after
-    reading the whole document, as ruamel constructs after composing).
+    Raises :class:`Unsupported` for what it leaves to ruamel, :class:`Refused` for a text
+    libyaml refuses, and ``ValueError`` for an integer too long to convert (after reading the
+    whole document, as ruamel constructs after composing).
     """
     if CParser is None:
         raise Unsupported("PyYAML without libyaml")
     if _RARE.search(text):
         raise Unsupported("a tab or a rare character")
-    parser = CParser(text)
+    stack: list[_Frame] = []
+    defined: set[str] = set()
+    try:
+        return _compose(CParser(text), stack, defined)
+    except LibyamlMarkedError as error:
+        spans = [] if defined else [(f.first_child, f.last_child) for f in stack]
+        spans = [(start, end) for start, end in spans if 0 <= start < end]
+        raise Refused(error, spans) from None
+
+
+def _compose(parser: Any, stack: list[_Frame], defined: set[str]) -> Document | None:
+    """The document of ``parser``'s events; ``stack`` holds the collections open, ``defined``
+    the anchors seen (for :func:`read_libyaml` when libyaml refuses the text)."""
     get = parser.get_event
     get()  # the stream's start
     event = get()
@@ -321,13 +375,18 @@ def read_libyaml(text: str) -> Document | None:
     if event.version is not None or event.tags:
         raise Unsupported("a directive")
     anchors: dict[str, tuple[Any, int, int]] = {}
-    defined: set[str] = set()
     duplicates: list[Duplicate] = []
-    stack: list[_Frame] = []
     too_long: ValueError | None = None
     while True:
         event = get()
         kind = type(event)
+        if kind is ScalarEvent or kind is AliasEvent:
+            if stack:  # a list item or a mapping key starts a child of its collection
+                parent = stack[-1]
+                if parent.key is None or isinstance(parent.value, YamlSeq):
+                    if parent.first_child < 0:
+                        parent.first_child = event.start_mark.index
+                    parent.last_child = event.start_mark.index
         if kind is ScalarEvent:
             if event.anchor is not None or event.tag is not None:
                 raise Unsupported("an anchored or tagged scalar")
@@ -356,17 +415,20 @@ def read_libyaml(text: str) -> Document | None:
                 if event.anchor in defined:
                     raise Unsupported("an anchor defined twice")
                 defined.add(event.anchor)
+            mark = event.start_mark
             if stack:
                 parent = stack[-1]
                 if isinstance(parent.value, YamlSeq):
                     path = f"{parent.path}[{len(parent.value)}]"
+                    if parent.first_child < 0:
+                        parent.first_child = mark.index
+                    parent.last_child = mark.index
                 elif parent.key is None:
                     raise Unsupported("a collection as a mapping key")
                 else:
                     path = join(parent.path, parent.key[2])
             else:
                 path = ""
-            mark = event.start_mark
             container = YamlMap() if kind is MappingStartEvent else YamlSeq()
             stack.append(_Frame(container, path, event.anchor, mark.line, mark.column))
             continue
