@@ -21,14 +21,15 @@ not scale fails instead of exhausting the machine. One run each: the figures are
 
 ``--files`` generates one file of each kind that makes checking expensive (see :data:`KINDS`:
 a 35,000-vertex polygon in 1 MB, the same file cut off mid-list, 8,500 uncertain objects, a
-thousand objects stacked at one pose, a hundred objects sharing a 1,000-vertex shape, a shape of
-2,500 convex parts, a 1,000-vertex part squeezed between two walls) and prints, for each, the
-size, the time to parse it with ruamel's round-trip loader (the reading before libyaml, which
-every YAML file went through) and with :func:`arrange_up.io.yaml_tree.read` (libyaml, ruamel for
-what it leaves), each the best of three in this process, and the wall time of
-``arrange-up check FILE`` in a fresh subprocess; with ``--baseline REV``, also ``check`` run
-from the tree of the git revision REV (exported to a temporary folder), on the same files
-(``+``: stopped after ``--timeout`` seconds). One run each: the figures are one run's.
+thousand objects stacked at one pose, a hundred objects sharing a 1,000-vertex shape, ten
+1,000-vertex polygons, a shape of 2,500 convex parts, a 1,000-vertex part squeezed between two
+walls) and prints, for each, the size, the time to parse it with ruamel's round-trip loader
+(the reading before libyaml, which every YAML file went through) and with
+:func:`arrange_up.io.yaml_tree.read` (libyaml, ruamel for what it leaves), each the best of
+three in this process, and the wall and CPU (user + system) time of ``arrange-up check FILE``
+in a fresh subprocess; with ``--baseline REV``, also ``check`` run from the tree of the git
+revision REV (exported to a temporary folder), on the same files (``+``: stopped after
+``--timeout`` seconds). One run each: the figures are one run's.
 """
 
 from __future__ import annotations
@@ -132,6 +133,23 @@ def shared_shape(objects: int, vertices: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+def many_polygons(n: int, vertices: int) -> str:
+    """``n`` different ``vertices``-vertex star shapes, one uncertain part each (10 x 1,000
+    vertices is the format's cap)."""
+    shapes = "".join(
+        f"  s{k}: {{polygon: [{_star_points(vertices, 0.5, 0.4 - 0.01 * k)}]}}\n" for k in range(n)
+    )
+    objects = "".join(f"  O{k}: {{kind: part, shape: s{k}}}\n" for k in range(n))
+    initial = "".join(
+        f"  O{k}: {{pose: [{1.0 + 2 * k}, 1.0, 0], uncertainty: [0.1, 0.1, 5]}}\n" for k in range(n)
+    )
+    return (
+        f"name: polygons-{n}\ntable: {{size: [{2.0 * n + 1}, 3]}}\nshapes:\n{shapes}"
+        f"objects:\n{objects}initial:\n{initial}goal:\n  tolerance: [0.2, 0.2]\n"
+        "  poses: {O0: [1.0, 1.0, 0]}\n"
+    )
+
+
 def many_parts(n: int) -> str:
     """One part made of ``n`` thin convex rectangles side by side."""
     parts = ", ".join(
@@ -164,6 +182,7 @@ KINDS = {
     "objects-8500": lambda: many_objects(8_500),
     "stacked-1000": lambda: stacked(1_000),
     "shared-100x1000": lambda: shared_shape(100, 1_000),
+    "polygons-10x1000": lambda: many_polygons(10, 1_000),
     "parts-2500": lambda: many_parts(2_500),
     "squeezed-1000": lambda: squeezed(1_000),
 }
@@ -199,39 +218,44 @@ def files(timeout: float, limit: int, baseline: str | None) -> None:
 
     with tempfile.TemporaryDirectory() as tmp:
         old_tree = _export(baseline, Path(tmp) / "baseline") if baseline else None
-        print(
-            f"{'file':<20} {'kB':>6}  parse: ruamel  libyaml   check s  "
-            + (f"check s at {baseline}" if baseline else "")
-        )
+        header = f"{'file':<20} {'kB':>6}  parse s: ruamel libyaml  check: wall s  CPU s"
+        print(header + (f"  at {baseline}: wall s  CPU s" if baseline else ""))
         for name, make in KINDS.items():
             text = make()
             path = Path(tmp) / f"{name}.yaml"
             path.write_text(text, encoding="utf-8")
             old_parse = _best_of_three(lambda text=text: yaml_tree.read_ruamel(text))
             new_parse = _best_of_three(lambda text=text: yaml_tree.read(text))
-            status, seconds, _ = run(["check", str(path)], timeout, limit)
+            status, seconds, _, cpu = run_child(["check", str(path)], timeout, limit)
             line = (
-                f"{name:<20} {len(text.encode()) / 1000:6.0f}  {old_parse:12.2f}  "
-                f"{new_parse:7.2f}  {seconds:8.2f}"
+                f"{name:<20} {len(text.encode()) / 1000:6.0f}  {old_parse:14.2f} "
+                f"{new_parse:7.2f}  {seconds:13.2f}  {cpu:5.2f}"
             )
             if old_tree is not None:
-                old_status, old_seconds, _ = run(
+                old_status, old_seconds, _, old_cpu = run_child(
                     ["check", str(path)], timeout, limit, pythonpath=old_tree
                 )
                 stopped = "+" if old_status.startswith("stopped") else " "
-                line += f"  {old_seconds:8.2f}{stopped}"
-            print(line + f"  ({status[:60]})")
+                line += f"  {old_seconds:19.2f}{stopped} {old_cpu:5.2f}"
+            print(line + f"  ({status[:40]})")
 
 
 def _limit(limit_bytes: int) -> None:
     resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
 
 
-def run(
+def run(args: list[str], timeout: float, limit_bytes: int) -> tuple[str, float, float]:
+    """Run ``python -m arrange_up ARGS`` in a child; ``(status, seconds, peak MB)``."""
+    status, seconds, peak, _ = run_child(args, timeout, limit_bytes)
+    return status, seconds, peak
+
+
+def run_child(
     args: list[str], timeout: float, limit_bytes: int, pythonpath: Path | None = None
-) -> tuple[str, float, float]:
+) -> tuple[str, float, float, float]:
     """Run ``python -m arrange_up ARGS`` in a child (the package of ``pythonpath`` when given,
-    else the one this process imports); ``(status, seconds, peak MB)``."""
+    else the one this process imports); ``(status, wall seconds, peak MB, CPU seconds)``, CPU
+    being the child's user + system time."""
     env = dict(os.environ)
     if pythonpath is not None:
         env["PYTHONPATH"] = str(pythonpath)
@@ -264,7 +288,8 @@ def run(
         status = f"stopped after {timeout:.0f} s"
     else:
         status = f"exit {proc.returncode}" + (f" ({tail[-1][:100]})" if tail else "")
-    return status, seconds, usage.ru_maxrss / 1024.0  # ru_maxrss is in kB on Linux
+    cpu = usage.ru_utime + usage.ru_stime
+    return status, seconds, usage.ru_maxrss / 1024.0, cpu  # ru_maxrss is in kB on Linux
 
 
 def main() -> None:

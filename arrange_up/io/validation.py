@@ -22,6 +22,7 @@ import math
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -119,8 +120,7 @@ def check_placement(
     reporting the overlap with the earlier. With ``max_overlaps``, only the first that many
     overlapping pairs (by later object, then earlier) are found and the rest are not looked for.
     """
-    moved = _Footprints()
-    footprints = [moved.at(item.shape, item.pose) for item in placed]
+    footprints = [_footprint(item.shape, item.pose) for item in placed]
     overlapping = _overlapping(footprints, limit=max_overlaps)
     checks = []
     for j, (item, footprint) in enumerate(zip(placed, footprints, strict=True)):
@@ -252,12 +252,13 @@ def unsampleable(problem: ArrangementProblem, draws: int = SAMPLE_DRAWS) -> bool
     if not entries:
         return False
     shapes = {spec.name: spec.shape for spec in problem.objects}
-    moved = _Footprints()
     # The fixed geometry of CollisionChecker: obstacles and the walls' boxes.
-    fixed = [moved.at(spec.shape, spec.pose) for spec in problem.obstacles if spec.pose is not None]
+    fixed = [
+        _footprint(spec.shape, spec.pose) for spec in problem.obstacles if spec.pose is not None
+    ]
     walls = geometry.wall_boxes(problem.table.size, problem.table.walls)
     fixed += [shapely.box(*wall) for wall in walls.values()]
-    still = [moved.at(shapes[e.name], e.pose) for e in problem.initial if not any(e.uncertainty)]
+    still = [_footprint(shapes[e.name], e.pose) for e in problem.initial if not any(e.uncertainty)]
     if _overlapping(still) or _first_overlap(still, fixed) is not None:
         return True  # the objects that never move already collide: so does every draw
     others = np.asarray(still + fixed, dtype=object)
@@ -272,7 +273,7 @@ def unsampleable(problem: ArrangementProblem, draws: int = SAMPLE_DRAWS) -> bool
         def footprint(entry: InitialObject, draw: list[float] = draw) -> Any:
             at = 3 * index[entry.name]
             pose = tuple(entry.pose[k] + draw[at + k] * entry.uncertainty[k] for k in range(3))
-            return moved.at(shapes[entry.name], pose)  # type: ignore[arg-type]
+            return _footprint(shapes[entry.name], pose)  # type: ignore[arg-type]
 
         if witness is not None:
             i, j = witness
@@ -314,20 +315,16 @@ def _collision(footprints: list[Any], others: Any, tree: STRtree | None) -> tupl
     return None
 
 
-class _Footprints:
-    """Footprints of shapes at poses: the union of a shape's parts at the origin is made once
-    per shape and moved to each pose (``transform_points``), where
+def _footprint(shape: Shape, pose: Pose) -> Any:
+    """The region ``shape`` covers at ``pose``: its footprint at the origin (made once per shape,
+    :func:`_at_origin`) moved by ``transform_points``, where
     :func:`~arrange_up.geometry.shapes.footprint` unites the moved parts at every pose. The same
     region up to rounding; the same coordinates for one-part shapes."""
+    return shapely.transform(_at_origin(shape), lambda points: transform_points(points, pose))
 
-    def __init__(self) -> None:
-        self._at_origin: dict[int, tuple[Shape, Any]] = {}
 
-    def at(self, shape: Shape, pose: Pose) -> Any:
-        known = self._at_origin.get(id(shape))
-        if known is None:
-            known = self._at_origin[id(shape)] = (
-                shape,
-                geometry.footprint(shape.parts, (0.0, 0.0, 0.0)),
-            )
-        return shapely.transform(known[1], lambda points: transform_points(points, pose))
+@lru_cache(maxsize=256)
+def _at_origin(shape: Shape) -> Any:
+    """The footprint of ``shape`` at the origin (the placement and the sampling checks of one
+    problem share it)."""
+    return geometry.footprint(shape.parts, (0.0, 0.0, 0.0))

@@ -25,9 +25,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ruamel.yaml import YAML
-from ruamel.yaml.error import MarkedYAMLError
 from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
+from ruamel.yaml.parser import ParserError
 from ruamel.yaml.resolver import VersionedResolver
+from ruamel.yaml.scanner import ScannerError
 
 try:  # PyYAML's binding of libyaml; PyYAML wheels ship it
     from yaml import MarkedYAMLError as LibyamlMarkedError
@@ -178,7 +179,7 @@ def _raise_ruamel_error(text: str, refused: Refused) -> None:
     shorter = "".join(pieces)
     try:
         read_ruamel(shorter)
-    except MarkedYAMLError as found:
+    except (ScannerError, ParserError) as found:  # a syntax error, not a later stage's
         where = found.problem_mark or found.context_mark
         if where is None or (cut < len(text) and where.index >= len(shorter) - _CUT_MARGIN):
             return
