@@ -22,17 +22,29 @@ import math
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import shapely
+from shapely import STRtree
 
 from arrange_up.geometry import shapes as geometry
-from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.model.problem import ArrangementProblem, ConvexPolygon, Pose, Shape
-from arrange_up.model.world import WorldState
+from arrange_up.geometry.se2 import transform_points
+from arrange_up.model.problem import (
+    ArrangementProblem,
+    ConvexPolygon,
+    InitialObject,
+    Pose,
+    Shape,
+)
 
 __all__ = [
     "AREA_TOLERANCE",
     "BOUNDS_TOLERANCE",
     "MAX_ANGLE",
     "MAX_FRICTION",
+    "MAX_LISTED_OVERLAPS",
     "SAMPLE_DRAWS",
     "Placed",
     "PlacementCheck",
@@ -55,6 +67,10 @@ MAX_ANGLE = 2.0**24
 #: Friction coefficients above this are warned about: real table-top materials stay below ~1.5
 #: (rubber on rubber), and far higher values make every push stick.
 MAX_FRICTION = 10.0
+#: Overlapping pairs (of objects, or of a shape's convex parts) a reader lists one by one; it
+#: says that there are more beyond them (a thousand objects stacked at one pose make half a
+#: million pairs, which are neither worth computing nor reading).
+MAX_LISTED_OVERLAPS = 100
 #: Draws :func:`unsampleable` makes: the particle sampler gives up on a particle after as many.
 SAMPLE_DRAWS = 1000
 
@@ -91,16 +107,21 @@ class PlacementCheck:
 
 
 def check_placement(
-    placed: Sequence[Placed], table_size: tuple[float, float] | None
+    placed: Sequence[Placed],
+    table_size: tuple[float, float] | None,
+    *,
+    max_overlaps: int | None = None,
 ) -> list[PlacementCheck]:
     """One :class:`PlacementCheck` per object of ``placed``, in order.
 
     The table is ``[0, width] x [0, depth]`` for ``table_size = (width, depth)`` (inches); a
     footprint may stick out by :data:`BOUNDS_TOLERANCE`. ``table_size=None`` (a table that could
     not be read) skips the table check. Each pair of objects is checked once, the later one
-    reporting the overlap with the earlier.
+    reporting the overlap with the earlier. With ``max_overlaps``, only the first that many
+    overlapping pairs (by later object, then earlier) are found and the rest are not looked for.
     """
-    footprints = [geometry.footprint(item.shape.parts, item.pose) for item in placed]
+    footprints = [_footprint(item.shape, item.pose) for item in placed]
+    overlapping = _overlapping(footprints, limit=max_overlaps)
     checks = []
     for j, (item, footprint) in enumerate(zip(placed, footprints, strict=True)):
         outside: Bounds | None = None
@@ -110,29 +131,62 @@ def check_placement(
             tol = BOUNDS_TOLERANCE
             if xmin < -tol or ymin < -tol or xmax > width + tol or ymax > depth + tol:
                 outside = (xmin, ymin, xmax, ymax)
-        overlaps = []
-        for i in range(j):
-            area = footprint.intersection(footprints[i]).area
-            if area > AREA_TOLERANCE:
-                overlaps.append((i, area))
-        checks.append(PlacementCheck(item.name, outside, tuple(overlaps)))
+        checks.append(PlacementCheck(item.name, outside, tuple(overlapping.get(j, ()))))
     return checks
 
 
-def part_overlaps(parts: Sequence[ConvexPolygon]) -> list[tuple[int, int, float]]:
+def _overlapping(
+    footprints: Sequence[Any], *, earlier_first: bool = False, limit: int | None = None
+) -> dict[int, list[tuple[int, float]]]:
+    """``j -> [(i, area), ...]`` for the pairs ``i < j`` of ``footprints`` that overlap by more
+    than :data:`AREA_TOLERANCE`, ``i`` ascending; ``area`` is that of ``footprints[j]``
+    intersected with ``footprints[i]`` (``footprints[i]`` with ``footprints[j]`` when
+    ``earlier_first``: the operand order of the area's last bits). With ``limit``, only the
+    first ``limit`` pairs in ``(j, i)`` order.
+
+    Only pairs whose bounding boxes meet are intersected (a shapely STRtree finds them), so
+    many objects spread over a table cost about one intersection each, not one per pair; with
+    ``limit``, in chunks until enough are found (a stack of objects at one pose has a pair for
+    every two of them).
+    """
+    if len(footprints) < 2:
+        return {}
+    geoms = np.asarray(footprints, dtype=object)
+    later, earlier = STRtree(geoms).query(geoms)
+    keep = earlier < later
+    later, earlier = later[keep], earlier[keep]
+    order = np.lexsort((earlier, later))
+    later, earlier = later[order], earlier[order]
+    first, second = (earlier, later) if earlier_first else (later, earlier)
+    found: dict[int, list[tuple[int, float]]] = {}
+    count = 0
+    for start in range(0, len(later), _CHUNK if limit is not None else max(1, len(later))):
+        chunk = slice(start, start + _CHUNK) if limit is not None else slice(None)
+        areas = shapely.area(shapely.intersection(geoms[first[chunk]], geoms[second[chunk]]))
+        pairs = zip(later[chunk].tolist(), earlier[chunk].tolist(), areas.tolist(), strict=True)
+        for j, i, area in pairs:
+            if area > AREA_TOLERANCE:
+                if limit is not None and count == limit:
+                    return found
+                found.setdefault(j, []).append((i, area))
+                count += 1
+    return found
+
+
+#: Candidate pairs intersected at a time when only the first few overlaps are wanted.
+_CHUNK = 4096
+
+
+def part_overlaps(
+    parts: Sequence[ConvexPolygon], *, max_overlaps: int | None = None
+) -> list[tuple[int, int, float]]:
     """``(i, j, area)`` for every pair of convex parts ``i < j`` (indices into ``parts``, in the
     shape's frame) that overlap by more than :data:`AREA_TOLERANCE` square inches, ordered by
-    ``j`` then ``i``."""
+    ``j`` then ``i``; with ``max_overlaps``, only the first that many."""
     origin = (0.0, 0.0, 0.0)
-    found = []
-    for j in range(len(parts)):
-        for i in range(j):
-            a = geometry.footprint((parts[i],), origin)
-            b = geometry.footprint((parts[j],), origin)
-            area = float(a.intersection(b).area)
-            if area > AREA_TOLERANCE:
-                found.append((i, j, area))
-    return found
+    footprints = [geometry.footprint((part,), origin) for part in parts]
+    overlapping = _overlapping(footprints, earlier_first=True, limit=max_overlaps)
+    return [(i, j, area) for j, pairs in sorted(overlapping.items()) for i, area in pairs]
 
 
 def angle_problem(value: float) -> str | None:
@@ -180,26 +234,97 @@ def goal_outside(
 
 def unsampleable(problem: ArrangementProblem, draws: int = SAMPLE_DRAWS) -> bool:
     """True when none of ``draws`` initial states drawn uniformly from the initial intervals is
-    free of collisions (objects overlapping each other, an obstacle or a wall).
+    free of collisions (objects overlapping each other, an obstacle or a wall by more than
+    :data:`AREA_TOLERANCE`, the test of ``CollisionChecker.state_collides``).
 
     The particle sampler draws the same way and gives up on a particle after
     :data:`SAMPLE_DRAWS` tries, so such a problem cannot be planned for. The draws are seeded
     (the answer depends on the problem only) and stop at the first collision-free state, so a
     problem with a sensible uncertainty costs one collision test. Problems whose nominal
     placement is already refused are not asked about.
+
+    The cost stays near one collision test per draw whatever the shapes and the number of
+    objects: footprints are moved copies of each shape's footprint at the origin, objects
+    without uncertainty are tested once, pairs are found with an STRtree, and a draw first
+    tries the pair that collided in the draw before.
     """
     entries = [entry for entry in problem.initial if any(entry.uncertainty)]
     if not entries:
         return False
-    checker = CollisionChecker(problem)
+    shapes = {spec.name: spec.shape for spec in problem.objects}
+    # The fixed geometry of CollisionChecker: obstacles and the walls' boxes.
+    fixed = [
+        _footprint(spec.shape, spec.pose) for spec in problem.obstacles if spec.pose is not None
+    ]
+    walls = geometry.wall_boxes(problem.table.size, problem.table.walls)
+    fixed += [shapely.box(*wall) for wall in walls.values()]
+    still = [_footprint(shapes[e.name], e.pose) for e in problem.initial if not any(e.uncertainty)]
+    if _overlapping(still) or _first_overlap(still, fixed) is not None:
+        return True  # the objects that never move already collide: so does every draw
+    others = np.asarray(still + fixed, dtype=object)
+    tree = STRtree(others) if len(others) else None
+    witness: tuple[int, int] | None = None  # (moving, moving) or (moving, -1 - other)
+    index = {entry.name: k for k, entry in enumerate(problem.initial)}
     rng = random.Random(0)
     for _ in range(draws):
-        poses = {
-            entry.name: tuple(
-                entry.pose[k] + rng.uniform(-1.0, 1.0) * entry.uncertainty[k] for k in range(3)
-            )
-            for entry in problem.initial
-        }
-        if not checker.state_collides(WorldState.from_mapping(problem, poses)):
+        # rng.uniform(-1, 1) for each coordinate of each entry, in order; it is -1 + 2 * random()
+        draw = [-1.0 + 2.0 * rng.random() for _ in range(3 * len(index))]
+
+        def footprint(entry: InitialObject, draw: list[float] = draw) -> Any:
+            at = 3 * index[entry.name]
+            pose = tuple(entry.pose[k] + draw[at + k] * entry.uncertainty[k] for k in range(3))
+            return _footprint(shapes[entry.name], pose)  # type: ignore[arg-type]
+
+        if witness is not None:
+            i, j = witness
+            other = footprint(entries[j]) if j >= 0 else others[-1 - j]
+            if _overlap(footprint(entries[i]), other):
+                continue  # this pair collides again: so does the draw
+        witness = _collision([footprint(entry) for entry in entries], others, tree)
+        if witness is None:
             return False
     return True
+
+
+def _overlap(a: Any, b: Any) -> bool:
+    return bool(a.intersects(b) and a.intersection(b).area > AREA_TOLERANCE)
+
+
+def _first_overlap(footprints: Sequence[Any], others: Sequence[Any]) -> tuple[int, int] | None:
+    """``(i, k)``: a footprint that overlaps one of ``others``, or ``None``."""
+    if not footprints or not others:
+        return None
+    tree = STRtree(np.asarray(others, dtype=object))
+    pairs = tree.query(np.asarray(footprints, dtype=object), predicate="intersects")
+    for i, k in zip(pairs[0].tolist(), pairs[1].tolist(), strict=True):
+        if _overlap(footprints[i], others[k]):
+            return i, k
+    return None
+
+
+def _collision(footprints: list[Any], others: Any, tree: STRtree | None) -> tuple[int, int] | None:
+    """A colliding pair of one draw: ``(i, j)`` for two moving footprints, ``(i, -1 - k)`` for
+    a moving footprint and ``others[k]``; ``None`` when the draw is free of collisions."""
+    if tree is not None:
+        pairs = tree.query(np.asarray(footprints, dtype=object), predicate="intersects")
+        for i, k in zip(pairs[0].tolist(), pairs[1].tolist(), strict=True):
+            if _overlap(footprints[i], others[k]):
+                return i, -1 - k
+    for j, pairs in _overlapping(footprints).items():
+        return j, pairs[0][0]
+    return None
+
+
+def _footprint(shape: Shape, pose: Pose) -> Any:
+    """The region ``shape`` covers at ``pose``: its footprint at the origin (made once per shape,
+    :func:`_at_origin`) moved by ``transform_points``, where
+    :func:`~arrange_up.geometry.shapes.footprint` unites the moved parts at every pose. The same
+    region up to rounding; the same coordinates for one-part shapes."""
+    return shapely.transform(_at_origin(shape), lambda points: transform_points(points, pose))
+
+
+@lru_cache(maxsize=256)
+def _at_origin(shape: Shape) -> Any:
+    """The footprint of ``shape`` at the origin (the placement and the sampling checks of one
+    problem share it)."""
+    return geometry.footprint(shape.parts, (0.0, 0.0, 0.0))

@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass
 
 from arrange_up.io import validation
-from arrange_up.io.validation import Placed
+from arrange_up.io.validation import MAX_LISTED_OVERLAPS, Placed
 from arrange_up.io.yaml_settings import (
     SettingsReader,
 )
@@ -474,7 +474,9 @@ class ProblemBuilder(NodeReader):
                 placed.append((Placed(entry.name, obj.shape, entry.pose), node.child("pose")))
         placed.sort(key=lambda p: (p[1].line or 0, p[1].column or 0))
         table_size = None if table is None else table.size
-        checks = validation.check_placement([item for item, _ in placed], table_size)
+        checks = validation.check_placement(
+            [item for item, _ in placed], table_size, max_overlaps=MAX_LISTED_OVERLAPS + 1
+        )
 
         units = self.units
         if table is not None:
@@ -494,8 +496,18 @@ class ProblemBuilder(NodeReader):
                         f"{fmt(units.length_out(depth))}] {units.length}",
                     )
         area_unit = units.length_factor**2
+        listed = 0
         for (later, node), check in zip(placed, checks, strict=True):
             for index, overlap in check.overlaps:
+                listed += 1
+                if listed > MAX_LISTED_OVERLAPS:
+                    self.error(
+                        node,
+                        f"{later.name} and more objects overlap at their nominal poses: only "
+                        f"the first {MAX_LISTED_OVERLAPS} overlapping pairs are listed, the "
+                        "others are not looked for; expected shapes that touch at most",
+                    )
+                    break
                 earlier, earlier_node = placed[index]
                 self.error(
                     node,

@@ -175,15 +175,25 @@ class ShapeReader(NodeReader):
                 continue
             parts.append((index, item, ccw_polygon(points)))
         area_unit = self.units.length_factor**2
-        for i, j, overlap in validation.part_overlaps([p for _, _, p in parts]):
+        limit = validation.MAX_LISTED_OVERLAPS
+        found = validation.part_overlaps([p for _, _, p in parts], max_overlaps=limit + 1)
+        for count, (i, j, overlap) in enumerate(found, start=1):
             (index_i, _, _), (index_j, node_j, _) = parts[i], parts[j]
+            ok = False
+            if count > limit:
+                self.error(
+                    node_j,
+                    f"part [{index_j}] and more parts overlap: only the first {limit} "
+                    "overlapping pairs are listed, the others are not looked for; the convex "
+                    "parts of a shape may touch but not overlap",
+                )
+                break
             self.error(
                 node_j,
                 f"parts [{index_i}] and [{index_j}] overlap (area "
                 f"{fmt(overlap / area_unit)} {self.units.length}²); the convex parts of "
                 "a shape may touch but not overlap",
             )
-            ok = False
         if not ok:
             return None
         return centred_shape(tuple(p for _, _, p in parts), name)

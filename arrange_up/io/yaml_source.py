@@ -1,8 +1,9 @@
 """Reading YAML problem text with every value's position, and collecting diagnostics.
 
 The pieces under the problem builder (:mod:`arrange_up.io.yaml_builder`): :func:`read_text`
-reads a file's bytes as UTF-8, :func:`parse` parses YAML with ruamel's round-trip loader (which
-keeps every node's position) and reports duplicate keys, a :class:`Node` is one value with its
+reads a file's bytes as UTF-8, :func:`parse` parses YAML into a tree that keeps every value's
+position (:mod:`arrange_up.io.yaml_tree`: libyaml, or ruamel's round-trip loader for what
+libyaml's reading leaves to it) and reports duplicate keys, a :class:`Node` is one value with its
 1-based line and column and key path, a :class:`Report` collects the diagnostics of one source,
 and a :class:`NodeReader` checks values (numbers, vectors, mappings, lists) and records what is
 wrong at the node where it is written.
@@ -14,20 +15,19 @@ import difflib
 import math
 import re
 import sys
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ruamel.yaml import YAML
-from ruamel.yaml.comments import CommentedMap
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
-from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
 from ruamel.yaml.reader import ReaderError
 from ruamel.yaml.scalarbool import ScalarBoolean
 
+from arrange_up.io import yaml_tree
 from arrange_up.io.files import undecodable_place
 from arrange_up.io.validation import angle_problem
+from arrange_up.io.yaml_tree import YamlMap, join
 from arrange_up.model.errors import Diagnostic
 from arrange_up.model.problem import Pose
 from arrange_up.model.units import Units
@@ -79,17 +79,14 @@ def read_text(path: Path, source: str) -> tuple[str | None, Diagnostic | None]:
         )
 
 
-def parse(text: str, report: Report) -> Any:
-    """Parse YAML text with ruamel's round-trip loader (which keeps every node's position).
+def parse(text: str, report: Report) -> YamlMap | None:
+    """Parse YAML text into a tree that keeps every value's position (:mod:`.yaml_tree`).
 
     Returns the top-level mapping, or ``None`` after recording an error. Duplicate keys are
-    found on the composed node tree, so every duplicate is reported, not just the first.
+    found on the whole tree, so every duplicate is reported, not just the first.
     """
-    yaml = YAML(typ="rt")
-    yaml.allow_duplicate_keys = True  # found and reported by _find_duplicates instead
     try:
-        node = yaml.compose(text)
-        data = None if node is None else yaml.constructor.construct_document(node)
+        document = yaml_tree.read(text)
     except MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         what = str(error.problem or "syntax error")
@@ -133,7 +130,7 @@ def parse(text: str, report: Report) -> Any:
             report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
         return None
 
-    if node is None or data is None:
+    if document is None or document.root is None:
         report.error(
             (1, 1),
             "",
@@ -141,15 +138,16 @@ def parse(text: str, report: Report) -> Any:
             "objects and goal",
         )
         return None
-    if not isinstance(data, CommentedMap):
+    data = document.root
+    if not isinstance(data, YamlMap):
         report.error(
-            (node.start_mark.line + 1, node.start_mark.column + 1),
+            (document.line + 1, document.column + 1),
             "",
             f"not a problem file: the top level is {describe(data)}; expected a mapping with "
             "at least the keys name, table, objects and goal",
         )
         return None
-    for line, column, path, key, first in _find_duplicates(node):
+    for line, column, path, key, first in document.duplicates:
         report.error(
             (line, column),
             path,
@@ -169,40 +167,6 @@ def long_number(text: str) -> tuple[int | None, int | None, int]:
     before = text[: match.start()]
     line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
     return line, column, len(match.group(0))
-
-
-def _find_duplicates(root: Any) -> Iterator[tuple[int, int, str, str, tuple[int, int]]]:
-    """Every duplicate key in a composed node tree.
-
-    Yields ``(line, column, path, key, (first line, first column))``, 1-based.
-    """
-    seen: set[int] = set()
-    stack: list[tuple[Any, str]] = [(root, "")]
-    while stack:
-        node, path = stack.pop()
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        if isinstance(node, MappingNode):
-            first: dict[tuple[str, str], tuple[int, int]] = {}
-            for key_node, value_node in node.value:
-                if isinstance(key_node, ScalarNode):
-                    key_path = join(path, key_node.value)
-                    ident = (str(key_node.tag), str(key_node.value))
-                    if ident[0].endswith(":merge"):
-                        pass
-                    elif ident in first:
-                        mark = key_node.start_mark
-                        yield mark.line + 1, mark.column + 1, key_path, ident[1], first[ident]
-                    else:
-                        mark = key_node.start_mark
-                        first[ident] = (mark.line + 1, mark.column + 1)
-                else:
-                    key_path = join(path, "?")
-                stack.append((value_node, key_path))
-        elif isinstance(node, SequenceNode):
-            for index, item in enumerate(node.value):
-                stack.append((item, f"{path}[{index}]"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -293,16 +257,16 @@ class Node:
 
 
 def _lc(container: Any, kind: str, key: Any, default: Location) -> Location:
-    """1-based position of a key/value/item from ruamel's line-column records."""
+    """1-based position of a key, value or item (``kind``) from the tree's marks."""
     try:
-        line, column = getattr(container.lc, kind)(key)
+        if kind == "item":
+            line, column = container.marks[key]
+        else:
+            marks = container.marks[key]
+            line, column = (marks[0], marks[1]) if kind == "key" else (marks[2], marks[3])
         return line + 1, column + 1
-    except Exception:  # merged keys and constructed values have no record
+    except (AttributeError, LookupError, TypeError):  # merged keys have no marks
         return default
-
-
-def join(path: str, key: Any) -> str:
-    return f"{path}.{key}" if path else str(key)
 
 
 def at(node: Node) -> str:

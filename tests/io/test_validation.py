@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import dataclasses
+import random
 
 import pytest
 
 from arrange_up.geometry import shapes as geometry
+from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.pddl import load_pddl_problem_text, write_pddl_problem
 from arrange_up.io.validation import (
     AREA_TOLERANCE,
     MAX_ANGLE,
+    MAX_LISTED_OVERLAPS,
     SAMPLE_DRAWS,
     Placed,
     angle_problem,
@@ -21,7 +24,8 @@ from arrange_up.io.validation import (
 )
 from arrange_up.io.yaml_problem import check_problem_text, load_problem_text
 from arrange_up.model.errors import ProblemFormatError
-from arrange_up.model.problem import Shape
+from arrange_up.model.problem import ArrangementProblem, Shape
+from arrange_up.model.world import WorldState
 
 BLOCK = Shape((geometry.box_polygon(1.0, 1.0),), box=(1.0, 1.0))
 
@@ -165,3 +169,165 @@ def test_the_readers_refuse_an_unsampleable_belief_where_it_is_written() -> None
     (error,) = diagnostics
     assert str(error).startswith("row.yaml:7:3: error: initial: no collision-free initial state")
     assert f"in {SAMPLE_DRAWS} draws" in error.message
+
+
+# ---------------------------------------------------------------------------------------------
+# the same answers at any size
+# ---------------------------------------------------------------------------------------------
+def _every_pair(placed: list[Placed]) -> list[tuple[tuple[int, float], ...]]:
+    """The overlaps of :func:`check_placement` by intersecting every pair of footprints."""
+    footprints = [geometry.footprint(p.shape.parts, p.pose) for p in placed]
+    found = []
+    for j, b in enumerate(footprints):
+        pairs = ((i, b.intersection(a).area) for i, a in enumerate(footprints[:j]))
+        found.append(tuple((i, area) for i, area in pairs if area > AREA_TOLERANCE))
+    return found
+
+
+def test_placement_finds_the_overlaps_of_every_pair() -> None:
+    rng = random.Random(3)
+    ell = Shape(tuple(_scene("10, 5", "").objects[1].shape.parts))
+    placed = [
+        Placed(
+            f"O{k}",
+            BLOCK if k % 3 else ell,
+            (rng.uniform(0, 6), rng.uniform(0, 4), rng.uniform(-3, 3)),
+        )
+        for k in range(60)
+    ]
+    expected = _every_pair(placed)
+    found = [check.overlaps for check in check_placement(placed, (6.0, 4.0))]
+    assert sum(map(len, expected)) > 20  # the scene has many overlaps to find
+    assert [[i for i, _ in pairs] for pairs in found] == [[i for i, _ in p] for p in expected]
+    for pairs, reference in zip(found, expected, strict=True):
+        assert [area for _, area in pairs] == pytest.approx([a for _, a in reference], rel=1e-12)
+    blocks = [p for p in placed if p.shape is BLOCK]  # one-part shapes: the very same areas
+    assert [c.overlaps for c in check_placement(blocks, None)] == _every_pair(blocks)
+
+
+def test_placement_stops_after_the_overlaps_asked_for() -> None:
+    stacked = [Placed(f"O{k}", BLOCK, (2.0, 2.0, 0.0)) for k in range(30)]
+    checks = check_placement(stacked, (5.0, 5.0), max_overlaps=50)
+    found = [(j, i) for j, check in enumerate(checks) for i, _ in check.overlaps]
+    assert found == [(j, i) for j in range(30) for i in range(j)][:50]
+
+
+def test_part_overlaps_stop_after_the_overlaps_asked_for() -> None:
+    parts = [geometry.box_polygon(1.0, 1.0)] * 20
+    everything = part_overlaps(parts)
+    assert len(everything) == 190
+    assert part_overlaps(parts, max_overlaps=7) == everything[:7]
+
+
+def _unsampleable_by_the_checker(problem: ArrangementProblem) -> bool:
+    """The definition: seeded uniform draws, each tested by ``CollisionChecker``."""
+    if not any(any(entry.uncertainty) for entry in problem.initial):
+        return False
+    checker = CollisionChecker(problem)
+    rng = random.Random(0)
+    for _ in range(SAMPLE_DRAWS):
+        poses = {
+            entry.name: tuple(
+                entry.pose[k] + rng.uniform(-1.0, 1.0) * entry.uncertainty[k] for k in range(3)
+            )
+            for entry in problem.initial
+        }
+        if not checker.state_collides(WorldState.from_mapping(problem, poses)):
+            return False
+    return True
+
+
+def _scene(table: str, initial: str, obstacle: str = "") -> ArrangementProblem:
+    text = f"""
+name: scene
+table: {{size: [{table}]}}
+objects:
+  A: {{kind: part, shape: {{box: [1, 1]}}}}
+  B: {{kind: part, shape: {{polygon: [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}}}}
+  C: {{kind: fixture, shape: {{box: [0.5, 2]}}}}
+  D: {{kind: fixture, shape: {{box: [0.5, 2]}}}}
+  {obstacle}
+initial:
+{initial}
+goal: {{tolerance: [0.2, 0.2], poses: {{A: [0.5, 0.5, 0]}}}}
+"""
+    with pytest.MonkeyPatch.context() as patch:  # read it even when it is unsampleable
+        patch.setattr("arrange_up.io.validation.unsampleable", lambda problem: False)
+        return load_problem_text(text)
+
+
+SCENES = {
+    "free": ("10, 5", "  A: {pose: [2, 2, 0], uncertainty: [0.2, 0.2, 10]}"),
+    "squeezed between walls": ("1, 3", "  A: {pose: [0.5, 1.5, 0], uncertainty: [0.1, 0, 0]}"),
+    "squeezed between parts": (
+        "10, 5",
+        "  A: {pose: [2, 2, 0], uncertainty: [0.01, 0, 0]}\n"
+        "  C: {pose: [1.25, 2, 0]}\n  D: {pose: [2.75, 2, 0]}\n  B: {pose: [6, 2, 0]}",
+    ),
+    "often free": ("3, 3", "  A: {pose: [0.6, 1.5, 0], uncertainty: [0.3, 0.3, 40]}"),
+    "two moving": (
+        "4, 2",
+        "  A: {pose: [0.5, 0.5, 0], uncertainty: [0.1, 0.1, 5]}\n"
+        "  C: {pose: [1.5, 1, 0], uncertainty: [0.4, 0, 0]}",
+    ),
+    "squeezed between two moving": (
+        "1.5, 2",
+        "  A: {pose: [0.5, 1, 0], uncertainty: [0.05, 0, 0]}\n"
+        "  C: {pose: [1.25, 1, 0], uncertainty: [0.05, 0, 0]}",
+    ),
+    "beside an obstacle": (
+        "4, 2",
+        "  A: {pose: [1.5, 0.5, 0], uncertainty: [0.02, 0.02, 0]}",
+        "O: {kind: obstacle, shape: {box: [0.5, 0.5]}, pose: [0.75, 0.25, 0]}",
+    ),
+    "squeezed by an obstacle": (
+        "4, 2",
+        "  A: {pose: [3.5, 0.5, 0], uncertainty: [0.02, 0, 0]}",
+        "O: {kind: obstacle, shape: {box: [0.5, 0.5]}, pose: [2.75, 0.5, 0]}",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_unsampleable_answers_as_the_collision_checker_does(name: str) -> None:
+    problem = _scene(*SCENES[name])
+    assert unsampleable(problem) is _unsampleable_by_the_checker(problem)
+
+
+def test_the_scenes_have_both_answers() -> None:
+    answers = {name: unsampleable(_scene(*scene)) for name, scene in SCENES.items()}
+    assert sum(answers.values()) == 4 and len(answers) == 8
+
+
+def test_a_stack_of_objects_lists_the_first_overlaps_and_says_there_are_more() -> None:
+    names = [f"O{k}" for k in range(16)]  # 120 overlapping pairs, the 101st (O14, O9)
+    text = (
+        "name: stack\ntable: {size: [5, 5]}\nobjects:\n"
+        + "".join(f"  {n}: {{kind: part, shape: {{box: [1, 1]}}}}\n" for n in names)
+        + "initial:\n"
+        + "".join(f"  {n}: {{pose: [2, 2, 0]}}\n" for n in names)
+        + "goal: {tolerance: [0.2, 0.2], poses: {O0: [2, 2, 0]}}\n"
+    )
+    _, diagnostics = check_problem_text(text, "stack.yaml")
+    errors = [d for d in diagnostics if d.severity == "error"]
+    assert len(errors) == MAX_LISTED_OVERLAPS + 1
+    assert all(" overlaps O" in d.message for d in errors[:-1])
+    last = errors[-1]
+    assert last.path == "initial.O14.pose" and last.line == 35
+    assert last.message.startswith(
+        f"O14 and more objects overlap at their nominal poses: only the first "
+        f"{MAX_LISTED_OVERLAPS} overlapping pairs are listed"
+    )
+
+
+def test_a_shape_of_stacked_parts_lists_the_first_overlaps_and_says_there_are_more() -> None:
+    square = "[[0, 0], [1, 0], [1, 1], [0, 1]]"
+    text = (
+        "name: parts\ntable: {size: [5, 5]}\nobjects:\n  A:\n    kind: part\n    shape:\n"
+        f"      convex_parts: [{', '.join([square] * 16)}]\n"
+        "goal: {tolerance: [0.2, 0.2], poses: {A: [2, 2, 0]}}\n"
+    )
+    _, diagnostics = check_problem_text(text, "parts.yaml")
+    errors = [d for d in diagnostics if d.severity == "error"]
+    assert len(errors) == MAX_LISTED_OVERLAPS + 1
+    assert errors[-1].message.startswith("part [14] and more parts overlap: only the first")
