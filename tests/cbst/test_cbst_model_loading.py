@@ -145,7 +145,7 @@ def test_a_model_is_refused_where_it_cannot_be_used(own_model, tmp_path):
         make_semantics("deterministic", problem, model=own_model)
     with pytest.raises(LookupError, match="unknown CBST model"):
         plan(problem, semantics="cbst", model=tmp_path / "none.json")
-    assert (model_dir() / "default.json").is_file()
+    assert (model_dir() / "servo.json").is_file() and (model_dir() / "compliant.json").is_file()
 
 
 def test_the_engine_takes_a_model_parameter(own_model, tmp_path):

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from arrange_up.cli import main
 from arrange_up.io.resources import shipped_dir
 
-CARD = shipped_dir("semantics", "the shipped semantics") / "cbst" / "default.json"
+CARD = shipped_dir("semantics", "the shipped semantics") / "cbst" / "servo.json"
 
 
 def test_a_model_card_plans_and_is_recorded_in_the_plan_file(tmp_path: Path) -> None:
