@@ -387,7 +387,8 @@ def _resolve(name_or_path: str | Path) -> Path:
     names = sorted(p.stem for p in model_dir().glob("*.json"))
     raise LookupError(
         f"unknown CBST model {text!r}: no such card file and no shipped model of that name "
-        f"(shipped: {', '.join(names) or 'none'})"
+        f"(shipped: {', '.join(names) or 'none'}; {DEFAULT_MODEL!r}: the one of the "
+        "problem's controller)"
     )
 
 

@@ -109,7 +109,9 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 @click.option(
     "--model",
     default=None,
-    help="CBST model (--semantics cbst): a shipped name or the .json card train-cbst wrote.",
+    help="CBST model (--semantics cbst): a shipped name or the .json card train-cbst wrote; "
+    "it must have been trained under the problem's controller [default: the shipped model "
+    "of the problem's controller].",
 )
 @click.option(
     "--output",
