@@ -143,10 +143,18 @@ def test_a_data_file_of_another_controller_is_refused(tmp_path):
         generate_dataset(path, examples=2, rollouts=1, settings=servo)
 
 
-def test_the_cli_refuses_a_model_of_another_controller_with_exit_2(compliant_model):
+def _blocks_2_file(folder: Path, controller: str) -> Path:
+    source = shipped_dir("domains", "the shipped domains") / "blocks-2.yaml"
+    path = folder / "blocks-2-controller.yaml"
+    path.write_text(source.read_text() + f"controller: {controller}\n")
+    return path
+
+
+def test_the_cli_refuses_a_model_of_another_controller_with_exit_2(compliant_model, tmp_path):
+    problem = _blocks_2_file(tmp_path, "{kind: servo}")
     runner = CliRunner()
     result = runner.invoke(
-        main, ["plan", "blocks-2", "--semantics", "cbst", "--model", str(compliant_model)]
+        main, ["plan", str(problem), "--semantics", "cbst", "--model", str(compliant_model)]
     )
     assert result.exit_code == 2, result.output
     assert "trained under the compliant" in result.output and "uses the servo" in result.output
@@ -154,13 +162,10 @@ def test_the_cli_refuses_a_model_of_another_controller_with_exit_2(compliant_mod
 
 
 def test_the_cli_refuses_a_problem_no_shipped_model_fits_with_exit_2(tmp_path):
-    source = shipped_dir("domains", "the shipped domains") / "blocks-2.yaml"
-    text = source.read_text() + "controller: {kind: compliant, kp: 150}\n"
-    problem = tmp_path / "stiffer.yaml"
-    problem.write_text(text)
+    problem = _blocks_2_file(tmp_path, "{kind: compliant, kp: 150}")
     result = CliRunner().invoke(main, ["plan", str(problem), "--semantics", "cbst"])
     assert result.exit_code == 2, result.output
-    assert "stiffer.yaml" in result.output and "kp 150" in result.output
+    assert "blocks-2-controller.yaml" in result.output and "kp 150" in result.output
 
 
 def test_the_engine_answers_a_model_of_another_controller_with_an_error(compliant_model):
@@ -209,3 +214,9 @@ def test_rescoring_a_saved_model_replaces_only_its_scores(compliant_model, tmp_p
         rescore_model(
             card_path, data_path=tmp_path / "d.jsonl", test_data_path=tmp_path / "u", test_seed=3
         )
+
+
+def test_rescore_cli_refuses_an_unknown_model_with_exit_2(tmp_path):
+    args = ["rescore-cbst", "no-such", "--data", str(tmp_path / "d"), "--test-data", "t"]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2 and "unknown CBST model 'no-such'" in result.output
