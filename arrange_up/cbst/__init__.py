@@ -7,6 +7,8 @@
 * :mod:`~arrange_up.cbst.data`: the seeded, parallel, resumable training-data generator.
 * :mod:`~arrange_up.cbst.fast_forest`: a random forest as flat arrays, evaluated vectorised.
 * :mod:`~arrange_up.cbst.model`: :class:`CBSTRegressor`, tuning, storage, :func:`train_cbst`.
+* :mod:`~arrange_up.cbst.choice`: which model a problem plans with (the one trained under its
+  controller).
 
 The semantics itself is :class:`arrange_up.transitions.cbst.CBSTSemantics`
 (``plan(problem, semantics="cbst")``); see ``docs/cbst.md``.

@@ -67,12 +67,22 @@ import numpy as np
 from arrange_up.cbst.contact_graph import MIN_OVERLAP, MIN_OVERLAP_PADDLE, PUSH_MARGIN
 from arrange_up.cbst.features import Domain, feature_row
 from arrange_up.geometry.shapes import shadow_box
-from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind, ObjectSpec, Shape, Table
+from arrange_up.model.problem import (
+    ArrangementProblem,
+    Controller,
+    ControllerKind,
+    Goal,
+    ObjectKind,
+    ObjectSpec,
+    Shape,
+    Table,
+)
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.parallel import auto_chunksize, get_runner
 from arrange_up.physics.simulation import simulate
 
 __all__ = [
+    "COMPLIANT",
     "DATA_FORMAT",
     "Dataset",
     "GenerationSettings",
@@ -91,9 +101,18 @@ ProgressCallback = Callable[[str, int, int], None]
 EAST = -0.5 * math.pi
 
 
+#: The compliant controller with every gain at its documented default: what the shipped
+#: compliant model is trained in (named explicitly, not the problems' default controller, so a
+#: change of that default does not change the training data).
+COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
+SERVO = Controller(kind=ControllerKind.SERVO)
+
+
 @dataclass(frozen=True)
 class GenerationSettings:
-    """Every number of the example distribution (module docstring). Inches and degrees."""
+    """Every number of the example distribution (module docstring). Inches and degrees;
+    ``controller`` drives the paddle in every rollout (internal units, ``None`` fields at
+    their defaults: :class:`~arrange_up.model.problem.Controller`)."""
 
     block_size: float = 1.0
     paddle_size: tuple[float, float] = (2.5, 0.15)
@@ -110,12 +129,33 @@ class GenerationSettings:
     manipulator_density: tuple[float, float] = (0.35, 0.45)
     min_ok_fraction: float = 0.9
     max_blocks: int = 3
+    controller: Controller = COMPLIANT
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
 
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> GenerationSettings:
+        """The settings :meth:`as_dict` gave (as a model card stores them); settings without a
+        controller predate it and are the servo's."""
+        values = dict(data)
+        for name, value in values.items():
+            if isinstance(value, list):
+                values[name] = tuple(value)
+        values["domain"] = Domain.from_dict(values["domain"])
+        controller = dict(values.get("controller") or {"kind": ControllerKind.SERVO})
+        controller["kind"] = ControllerKind(controller["kind"])
+        values["controller"] = Controller(**controller)
+        return cls(**values)
+
     def digest(self) -> str:
-        text = json.dumps(self.as_dict(), sort_keys=True)
+        """A short hash of every setting. The controller is left out when it is the default
+        servo, so that servo data files (and the servo model's card) written before the
+        controller was a setting keep their digest."""
+        values = self.as_dict()
+        if self.controller == SERVO:
+            del values["controller"]
+        text = json.dumps(values, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -142,6 +182,7 @@ def _scene(settings: GenerationSettings):
         objects=tuple(objects),
         initial=(),
         goal=Goal(targets=(), tolerance=(0.1, 0.1, None)),
+        controller=settings.controller,
     )
 
 

@@ -4,18 +4,20 @@
   ``fit`` validates and returns ``self``, learned state ends in ``_``) wrapping a
   ``RandomForestRegressor``. After ``fit`` it predicts through a :class:`FastForest` copy of
   the trees, which gives the same numbers as the forest (to ~1e-15) many times faster.
-* :func:`tune` is the thesis's procedure: hold out 10 % of the data, grid-search the
-  hyperparameters with 8-fold cross-validation on the other 90 %, refit, and score on the
-  held-out part. Rows of one example (the blocks of one belief) never straddle a split:
-  the hold-out and the folds are made by example (``GroupShuffleSplit``/``GroupKFold``).
+* :func:`tune` grid-searches the hyperparameters with 8-fold cross-validation, as the thesis
+  did, and refits; :func:`cross_validate` gives per-target out-of-fold RMSE and R^2. Rows
+  of one example (the blocks of one belief) never straddle a fold (``GroupKFold``). The
+  unbiased figure is the score on a fresh test set generated with another seed
+  (:func:`train_cbst`; :func:`rescore_model` measures both again for a saved model).
 * :func:`save_model` writes ``NAME.npz`` (the trees' arrays, numbers only) and ``NAME.json``
   (the model card); :func:`load_model` reads them back with ``allow_pickle=False`` after
   checking the arrays' SHA-256 against the card. No model file is ever pickled.
 * :func:`train_cbst` is the whole pipeline behind ``arrange-up train-cbst``: generate (or
-  resume) the data, tune, evaluate, save.
+  resume) the data and a fresh test set under a given controller, tune, score, save.
 
 Shipped models live in the repository's ``semantics/cbst/`` (an installed wheel carries it as
-``arrange_up/_shipped/semantics/cbst``); ``load_model("default")`` finds either.
+``arrange_up/_shipped/semantics/cbst``), one per controller kind (:data:`SHIPPED_MODELS`);
+``load_model("default", controller)`` finds the one for ``controller`` in either.
 """
 
 from __future__ import annotations
@@ -26,7 +28,8 @@ import json
 import math
 import time
 from collections.abc import Callable, Mapping
-from functools import lru_cache
+from dataclasses import replace
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any
 
@@ -36,7 +39,13 @@ from sklearn.base import BaseEstimator, MultiOutputMixin, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from arrange_up import __version__
-from arrange_up.cbst.data import DEFAULT_GENERATION, generate_dataset, load_dataset
+from arrange_up.cbst.data import (
+    DEFAULT_GENERATION,
+    Dataset,
+    GenerationSettings,
+    generate_dataset,
+    load_dataset,
+)
 from arrange_up.cbst.fast_forest import FastForest
 from arrange_up.cbst.features import (
     BUCKLE_LIMIT,
@@ -47,21 +56,36 @@ from arrange_up.cbst.features import (
     Domain,
 )
 from arrange_up.io.resources import shipped_dir
+from arrange_up.model.problem import DEFAULT_CONTROLLER, Controller, ControllerKind
 from arrange_up.parallel import available_cores
 
 __all__ = [
     "CARD_FORMAT",
     "DEFAULT_GRID",
+    "DEFAULT_MODEL",
+    "SHIPPED_MODELS",
     "DY_RESIDUAL",
     "CBSTRegressor",
+    "cross_validate",
     "load_model",
     "model_dir",
+    "rescore_model",
     "save_model",
+    "shipped_name",
     "train_cbst",
     "tune",
 ]
 
 CARD_FORMAT = "arrange-up-cbst-model/1"
+
+#: The name of the shipped model for the problem's controller.
+DEFAULT_MODEL = "default"
+
+#: The shipped model trained under each controller kind (``semantics/cbst/NAME.json``).
+SHIPPED_MODELS: dict[ControllerKind, str] = {
+    ControllerKind.COMPLIANT: "compliant",
+    ControllerKind.SERVO: "servo",
+}
 
 #: Output ``dy`` (1) learned as a residual over the feature ``dy_c`` (4): see
 #: :class:`CBSTRegressor`'s ``residual``.
@@ -206,9 +230,48 @@ class CBSTRegressor(MultiOutputMixin, RegressorMixin, BaseEstimator):
 # ----------------------------------------------------------------------------------------------
 # The thesis's training procedure
 # ----------------------------------------------------------------------------------------------
-def _rmse(y_true: np.ndarray, y_pred: np.ndarray) -> dict[str, float]:
-    err = np.sqrt(np.mean((np.asarray(y_true) - np.asarray(y_pred)) ** 2, axis=0))
-    return {name: float(v) for name, v in zip(TARGET_NAMES, err, strict=True)}
+def _scores(y_true: np.ndarray, y_pred: np.ndarray) -> dict[str, dict[str, float]]:
+    """Per target: ``rmse`` and ``r2`` (the coefficient of determination, 1 - SSE/SST: the
+    share of the target's variance the predictions explain; 0 for predicting the mean)."""
+    y_true, y_pred = np.asarray(y_true, dtype=float), np.asarray(y_pred, dtype=float)
+    sse = np.sum((y_true - y_pred) ** 2, axis=0)
+    sst = np.sum((y_true - y_true.mean(axis=0)) ** 2, axis=0)
+    rmse = np.sqrt(sse / len(y_true))
+    r2 = np.where(sst > 0.0, 1.0 - sse / np.where(sst > 0.0, sst, 1.0), 0.0)
+    return {
+        "rmse": {name: float(v) for name, v in zip(TARGET_NAMES, rmse, strict=True)},
+        "r2": {name: float(v) for name, v in zip(TARGET_NAMES, r2, strict=True)},
+    }
+
+
+def cross_validate(
+    params: Mapping[str, Any],
+    X: np.ndarray,
+    y: np.ndarray,
+    groups: np.ndarray,
+    *,
+    cv: int = 8,
+    workers: int = 1,
+) -> dict[str, dict[str, float]]:
+    """Per-target RMSE and R^2 (:func:`_scores`) of the out-of-fold predictions of a
+    :class:`CBSTRegressor` with ``params``, refitted on each of ``cv`` folds made by example
+    (``GroupKFold`` on ``groups``: the rows of one example never straddle a fold)."""
+    from joblib import parallel_config
+    from sklearn.model_selection import GroupKFold, cross_val_predict
+
+    # Threads, not joblib's loky processes: the data generation leaves the process's shared
+    # loky executor (arrange_up.parallel) running, and joblib.Parallel cannot take that one
+    # over (AttributeError: _temp_folder_manager). Tree building releases the GIL.
+    with parallel_config(backend="threading"):
+        oof = cross_val_predict(
+            CBSTRegressor(**params),
+            X,
+            y,
+            groups=groups,
+            cv=GroupKFold(n_splits=cv),
+            n_jobs=workers,
+        )
+    return _scores(y, oof)
 
 
 def tune(
@@ -219,60 +282,40 @@ def tune(
     param_grid: Mapping[str, list[Any]] | None = None,
     n_estimators: int = 100,
     cv: int = 8,
-    test_fraction: float = 0.1,
     seed: int = 0,
     workers: int = 1,
 ) -> tuple[CBSTRegressor, dict[str, Any]]:
-    """Grid search with ``cv``-fold CV on ``1 - test_fraction`` of the examples, refit on
-    them, score on the held-out examples.
+    """Grid search with ``cv``-fold cross-validation by example (``GroupKFold``) on all of
+    ``X``, then refit on all of it.
 
-    Selection uses the mean R^2 over the three outputs (scale-free: the angle target is in
-    degrees and would dominate a mean squared error). Returns the refitted model and a report
-    with the best parameters, per-output CV RMSE (out-of-fold predictions of the best
-    parameters) and test RMSE.
+    Selection uses the mean R^2 over the outputs (scale-free: the angle target is in degrees
+    and would dominate a mean squared error). Returns the refitted model and a report with
+    the grid, the best parameters, their mean CV R^2 (``selection_r2``) and per-target CV
+    RMSE and R^2 (``cv_rmse``, ``cv_r2``: out-of-fold predictions of the best parameters;
+    the parameters were chosen on the same folds, so a fresh test set is the unbiased
+    figure, see :func:`train_cbst`).
     """
     from joblib import parallel_config
-    from sklearn.model_selection import (
-        GridSearchCV,
-        GroupKFold,
-        GroupShuffleSplit,
-        cross_val_predict,
-    )
+    from sklearn.model_selection import GridSearchCV, GroupKFold
 
     grid = dict(param_grid or DEFAULT_GRID)
-    split = GroupShuffleSplit(n_splits=1, test_size=test_fraction, random_state=seed)
-    train_idx, test_idx = next(split.split(X, y, groups))
-    X_train, y_train, g_train = X[train_idx], y[train_idx], groups[train_idx]
-    X_test, y_test = X[test_idx], y[test_idx]
     base = CBSTRegressor(n_estimators=n_estimators, random_state=seed, n_jobs=1)
     folds = GroupKFold(n_splits=cv)
     search = GridSearchCV(base, grid, scoring="r2", cv=folds, n_jobs=workers, refit=True)
     started = time.monotonic()
-    # Threads, not joblib's loky processes: the data generation leaves the process's shared
-    # loky executor (arrange_up.parallel) running, and joblib.Parallel cannot take that one
-    # over (AttributeError: _temp_folder_manager). Tree building releases the GIL.
-    with parallel_config(backend="threading"):
-        search.fit(X_train, y_train, groups=g_train)
-        oof = cross_val_predict(
-            CBSTRegressor(**search.best_estimator_.get_params()),
-            X_train,
-            y_train,
-            groups=g_train,
-            cv=folds,
-            n_jobs=workers,
-        )
+    with parallel_config(backend="threading"):  # see cross_validate
+        search.fit(X, y, groups=groups)
     best: CBSTRegressor = search.best_estimator_
+    cv_scores = cross_validate(best.get_params(), X, y, groups, cv=cv, workers=workers)
     report = {
         "best_params": {k: _jsonable(v) for k, v in search.best_params_.items()},
         "grid": {k: [_jsonable(v) for v in vs] for k, vs in grid.items()},
         "cv_folds": cv,
-        "cv_r2": float(search.best_score_),
-        "cv_rmse": _rmse(y_train, oof),
-        "test_rmse": _rmse(y_test, best.predict(X_test)),
-        "train_rows": int(len(train_idx)),
-        "test_rows": int(len(test_idx)),
-        "train_examples": int(len(np.unique(g_train))),
-        "test_examples": int(len(np.unique(groups[test_idx]))),
+        "selection_r2": float(search.best_score_),
+        "cv_rmse": cv_scores["rmse"],
+        "cv_r2": cv_scores["r2"],
+        "rows": int(len(X)),
+        "examples": int(len(np.unique(groups))),
         "search_seconds": time.monotonic() - started,
     }
     return best, report
@@ -320,6 +363,14 @@ def save_model(
     return card_path
 
 
+def shipped_name(name_or_path: str | Path, controller: Controller | None = None) -> str | Path:
+    """``name_or_path`` with :data:`DEFAULT_MODEL` replaced by the shipped model of
+    ``controller``'s kind (``None``: the problems' default controller)."""
+    if str(name_or_path) != DEFAULT_MODEL:
+        return name_or_path
+    return SHIPPED_MODELS[(controller or DEFAULT_CONTROLLER).kind]
+
+
 def _resolve(name_or_path: str | Path) -> Path:
     """The card of a model given by shipped name, by card path or by ``.npz`` path."""
     text = str(name_or_path)
@@ -336,14 +387,19 @@ def _resolve(name_or_path: str | Path) -> Path:
     names = sorted(p.stem for p in model_dir().glob("*.json"))
     raise LookupError(
         f"unknown CBST model {text!r}: no such card file and no shipped model of that name "
-        f"(shipped: {', '.join(names) or 'none'})"
+        f"(shipped: {', '.join(names) or 'none'}; {DEFAULT_MODEL!r}: the one of the "
+        "problem's controller)"
     )
 
 
-def load_model(name_or_path: str | Path = "default") -> CBSTRegressor:
-    """A fitted :class:`CBSTRegressor` from a shipped name (``"default"``) or a card/arrays
-    path. The card is attached as ``model.card_`` and the validity domain as
-    ``model.domain_``. Cached per resolved path.
+def load_model(
+    name_or_path: str | Path = DEFAULT_MODEL, controller: Controller | None = None
+) -> CBSTRegressor:
+    """A fitted :class:`CBSTRegressor` from a shipped name (``"default"``: the shipped model of
+    ``controller``, see :func:`shipped_name`) or a card/arrays path. The card is attached as
+    ``model.card_``, its path as ``model.card_path_`` and the validity domain as
+    ``model.domain_``. Cached per resolved path. Whether the model suits a problem's
+    controller is :func:`arrange_up.cbst.choice.model_for`'s check.
 
     Raises ``LookupError`` for an unknown name and one ``ValueError`` naming the file for a
     model that is not sound: a card that is not one, an arrays file not beside the card (a
@@ -353,7 +409,7 @@ def load_model(name_or_path: str | Path = "default") -> CBSTRegressor:
     count or depth differ from the card or the trees, trees that are not trees, non-finite
     thresholds or values; non-finite or non-positive sizes and domain in the card.
     """
-    card_path = _resolve(name_or_path).resolve()
+    card_path = _resolve(shipped_name(name_or_path, controller)).resolve()
     stat = card_path.stat()
     return _load_cached(str(card_path), stat.st_mtime_ns, stat.st_size)
 
@@ -390,6 +446,7 @@ def _load_cached(card_path: str, _mtime: int, _size: int) -> CBSTRegressor:
         params = card.get("model", {}).get("params")
         model = CBSTRegressor.from_forest(forest, params)
         model.card_ = card
+        model.card_path_ = path
         model.domain_ = _checked_card_numbers(card)
     except _ModelError as error:
         raise ValueError(f"{error.where or path}: {error}") from None
@@ -595,6 +652,47 @@ def _row_depths(X: np.ndarray, groups: np.ndarray) -> np.ndarray:
     return depths
 
 
+def _test_scores(model: CBSTRegressor, test: Dataset, seed: int, path: Path) -> dict[str, Any]:
+    """The scores of ``model`` on the fresh test set ``test`` (generated with ``seed``)."""
+    scores = _scores(test.y, model.predict(test.X))
+    return {
+        "test_rmse": scores["rmse"],
+        "test_r2": scores["r2"],
+        "test": {
+            "examples": test.examples,
+            "invalid_examples": test.invalid,
+            "rows": int(len(test.X)),
+            "rollouts_per_example": test.rollouts,
+            "seed": seed,
+            "file": path.name,
+        },
+    }
+
+
+def _score_card(cv_scores: Mapping[str, Any], test_scores: Mapping[str, Any]) -> dict:
+    return {
+        "method": (
+            f"cv_*: {cv_scores['cv_folds']}-fold GroupKFold (by example) over the training "
+            "data, out-of-fold predictions of the card's hyperparameters; test_*: the model "
+            "on a fresh test set generated with another seed (scores.test)"
+        ),
+        "cv_folds": cv_scores["cv_folds"],
+        "cv_rmse": cv_scores["cv_rmse"],
+        "cv_r2": cv_scores["cv_r2"],
+        **test_scores,
+        "thesis_test_rmse": THESIS_TEST_RMSE,
+        "units": dict(zip(TARGET_NAMES, TARGET_UNITS, strict=True)),
+    }
+
+
+def _fresh_seed(seed: int, test_seed: int) -> None:
+    if test_seed == seed:
+        raise ValueError(
+            f"the test set must be generated with another seed than the training data "
+            f"(both {seed}): a fresh test set"
+        )
+
+
 def train_cbst(
     examples: int = 1800,
     rollouts_per_example: int = 1000,
@@ -602,57 +700,103 @@ def train_cbst(
     workers: int | None = 1,
     output_dir: str | Path | None = None,
     *,
+    controller: Controller | None = None,
+    settings: GenerationSettings | None = None,
+    test_examples: int = 200,
+    test_seed: int = 1,
     backend: str = "local",
     scheduler: str | None = None,
-    name: str = "default",
+    name: str | None = None,
     data_path: str | Path | None = None,
+    test_data_path: str | Path | None = None,
     param_grid: Mapping[str, list[Any]] | None = None,
     n_estimators: int = 100,
     progress: ProgressCallback | None = None,
 ) -> dict[str, Any]:
-    """Generate (or resume) the training data, tune and evaluate the model as the thesis
-    does, and save ``NAME.npz`` + ``NAME.json`` into ``output_dir``.
+    """Generate (or resume) the training data and a fresh test set, tune the model by
+    cross-validation, score it, and save ``NAME.npz`` + ``NAME.json`` into ``output_dir``.
 
     Parameters
     ----------
     examples, rollouts_per_example
         Data set size: beliefs, and simulated pushes per belief (thesis: 1800 x 1000).
     seed
-        Seeds the data (example ``i`` depends only on ``(seed, i)``), the split and the forest.
+        Seeds the data (example ``i`` depends only on ``(seed, i)``) and the forest.
     workers
         Processes for data generation and for the grid search (``None``: every core).
+    controller, settings
+        The physics of the rollouts: ``settings`` (default
+        :data:`~arrange_up.cbst.data.DEFAULT_GENERATION`) with its controller replaced by
+        ``controller`` when given (default: the settings', the compliant controller at its
+        defaults). The card names the controller; a model plans only problems with it.
+    test_examples, test_seed
+        The fresh test set: examples of the same distribution and rollouts, generated with
+        ``test_seed`` (which must differ from ``seed``).
     backend, scheduler
         Where the data is generated (:func:`arrange_up.parallel.get_runner`): ``"local"``
         processes, or ``"dask"`` (a local cluster, or the one at ``scheduler``). The grid
-        search always runs locally with ``workers`` processes.
+        search always runs locally with ``workers`` threads.
     output_dir
-        Where to write the model (default ``./cbst-model``; the shipped model lives in the
+        Where to write the model (default ``./cbst-model``; the shipped models live in the
         repository's ``semantics/cbst``).
-    data_path
-        The resumable ``.jsonl`` data file (default ``OUTPUT_DIR/NAME.data.jsonl``); rerunning
-        with the same arguments skips the examples already in it.
+    name
+        The model's name (default: the controller kind's shipped name, ``compliant`` or
+        ``servo``).
+    data_path, test_data_path
+        The resumable ``.jsonl`` data files (default ``OUTPUT_DIR/NAME.data.jsonl`` and
+        ``OUTPUT_DIR/NAME.test.jsonl``); rerunning with the same arguments skips the
+        examples already in them.
     progress
-        ``progress(stage, done, total)`` with stage ``"data"``, then ``"fit"`` (0/1, 1/1).
+        ``progress(stage, done, total)`` with stage ``"data"``, ``"test data"``, then
+        ``"fit"`` (0/1, 1/1).
 
     Returns the model card (also written as ``NAME.json``).
     """
     workers = available_cores() if workers is None else workers
     if examples < 10:
-        raise ValueError("examples must be at least 10 (8-fold CV on 90% of them)")
+        raise ValueError("examples must be at least 10 (8-fold CV by example)")
+    if test_examples < 1:
+        raise ValueError("test_examples must be at least 1")
+    _fresh_seed(seed, test_seed)
+    settings = settings or DEFAULT_GENERATION
+    if controller is not None:
+        settings = replace(settings, controller=controller)
+    name = name or SHIPPED_MODELS[settings.controller.kind]
     out = Path(output_dir) if output_dir is not None else Path("cbst-model")
     data = Path(data_path) if data_path is not None else out / f"{name}.data.jsonl"
+    test_data = Path(test_data_path) if test_data_path is not None else out / f"{name}.test.jsonl"
+    if data.resolve() == test_data.resolve():
+        raise ValueError(f"{data}: the training data and the test set need separate files")
     started = time.monotonic()
+    parallel = {"workers": workers, "backend": backend, "scheduler": scheduler}
     summary = generate_dataset(
         data,
         examples=examples,
         rollouts=rollouts_per_example,
         seed=seed,
-        workers=workers,
-        backend=backend,
-        scheduler=scheduler,
+        settings=settings,
         progress=progress,
+        **parallel,
     )
-    dataset = load_dataset(data, examples=examples, seed=seed, rollouts=rollouts_per_example)
+    test_summary = generate_dataset(
+        test_data,
+        examples=test_examples,
+        rollouts=rollouts_per_example,
+        seed=test_seed,
+        settings=settings,
+        progress=None if progress is None else partial(_relabel, progress, "test data"),
+        **parallel,
+    )
+    dataset = load_dataset(
+        data, examples=examples, seed=seed, rollouts=rollouts_per_example, settings=settings
+    )
+    test = load_dataset(
+        test_data,
+        examples=test_examples,
+        seed=test_seed,
+        rollouts=rollouts_per_example,
+        settings=settings,
+    )
     if progress is not None:
         progress("fit", 0, 1)
     model, report = tune(
@@ -667,13 +811,17 @@ def train_cbst(
     if progress is not None:
         progress("fit", 1, 1)
     depths = _row_depths(dataset.X, dataset.groups)
-    settings = DEFAULT_GENERATION
+    # Lazy: choice imports this module (it loads the models it checks).
+    from arrange_up.cbst.choice import controller_record
+
     card: dict[str, Any] = {
         "description": (
             "Learned PREDICT of CBST (thesis §3.2): multi-output random forest mapping "
             "(prev, cur, next) interval beliefs of a push toward a wall to the uncertainty of "
-            "cur after the push. See docs/cbst.md."
+            f"cur after the push, trained under the {settings.controller.kind} controller. "
+            "See docs/cbst.md."
         ),
+        "controller": controller_record(settings.controller),
         "created": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "arrange_up_version": __version__,
         "sklearn_version": sklearn.__version__,
@@ -687,6 +835,8 @@ def train_cbst(
             "generation_cpu_seconds": round(dataset.example_seconds, 1),
             "generation_wall_seconds_this_run": round(summary["seconds"], 1),
             "examples_computed_this_run": summary["computed"],
+            "test_generation_cpu_seconds": round(test.example_seconds, 1),
+            "test_generation_wall_seconds_this_run": round(test_summary["seconds"], 1),
             "workers": workers,
             "backend": backend,
             "file": data.name,
@@ -710,13 +860,95 @@ def train_cbst(
             "selection": "GridSearchCV, scoring mean R^2, GroupKFold by example",
             **report,
         },
-        "scores": {
-            "cv_rmse": report["cv_rmse"],
-            "test_rmse": report["test_rmse"],
-            "thesis_test_rmse": THESIS_TEST_RMSE,
-            "units": dict(zip(TARGET_NAMES, TARGET_UNITS, strict=True)),
-        },
+        "scores": _score_card(report, _test_scores(model, test, test_seed, test_data)),
         "training_seconds": round(time.monotonic() - started, 1),
     }
     save_model(model, card, out, name)
     return json.loads((out / f"{name}.json").read_text(encoding="utf-8"))
+
+
+def _relabel(progress: ProgressCallback, stage: str, _stage: str, done: int, total: int) -> None:
+    progress(stage, done, total)
+
+
+def rescore_model(
+    name_or_path: str | Path,
+    *,
+    data_path: str | Path,
+    test_data_path: str | Path,
+    test_examples: int = 200,
+    test_seed: int = 1,
+    workers: int | None = 1,
+    backend: str = "local",
+    scheduler: str | None = None,
+    write: bool = False,
+    progress: ProgressCallback | None = None,
+) -> dict[str, Any]:
+    """The card ``scores`` of a saved model, measured again: its training data regenerated
+    (or resumed) from the card's examples, rollouts, seed and settings into ``data_path``
+    for the CV figures (its hyperparameters refitted on 8 folds by example), and a fresh
+    test set of ``test_examples`` with ``test_seed`` in ``test_data_path`` for the model's
+    own arrays. With ``write`` the card's ``scores`` are replaced (the arrays and their
+    checksum are untouched). Returns the new scores.
+
+    For models saved before the cards reported CV R^2 and a fresh test set (the servo
+    model); a model :func:`train_cbst` makes has these scores already."""
+    workers = available_cores() if workers is None else workers
+    model = load_model(name_or_path)
+    card = model.card_
+    info = card["data"]
+    seed, rollouts = int(info["seed"]), int(info["rollouts_per_example"])
+    _fresh_seed(seed, test_seed)
+    settings = GenerationSettings.from_dict(info["settings"])
+    if settings.digest() != info["settings_digest"]:
+        raise ValueError(
+            f"{model.card_path_}: the card's settings do not give its settings digest "
+            f"({settings.digest()} != {info['settings_digest']}): generated by another version"
+        )
+    parallel = {"workers": workers, "backend": backend, "scheduler": scheduler}
+    for path, n, s, stage in (
+        (data_path, int(info["examples"]), seed, "data"),
+        (test_data_path, test_examples, test_seed, "test data"),
+    ):
+        generate_dataset(
+            path,
+            examples=n,
+            rollouts=rollouts,
+            seed=s,
+            settings=settings,
+            progress=None if progress is None else partial(_relabel, progress, stage),
+            **parallel,
+        )
+    dataset = load_dataset(
+        data_path, examples=int(info["examples"]), seed=seed, rollouts=rollouts, settings=settings
+    )
+    test = load_dataset(
+        test_data_path,
+        examples=test_examples,
+        seed=test_seed,
+        rollouts=rollouts,
+        settings=settings,
+    )
+    if progress is not None:
+        progress("fit", 0, 1)
+    folds = int(card["model"].get("cv_folds", 8))
+    cv_scores = cross_validate(
+        card["model"]["params"], dataset.X, dataset.y, dataset.groups, cv=folds, workers=workers
+    )
+    if progress is not None:
+        progress("fit", 1, 1)
+    scores = _score_card(
+        {"cv_folds": folds, "cv_rmse": cv_scores["rmse"], "cv_r2": cv_scores["r2"]},
+        _test_scores(model, test, test_seed, Path(test_data_path)),
+    )
+    scores["cv_data"] = {
+        "examples": dataset.examples,
+        "rows": int(len(dataset.X)),
+        "file": Path(data_path).name,
+    }
+    if write:
+        card = dict(card)
+        card["scores"] = scores
+        path = model.card_path_
+        path.write_text(json.dumps(card, indent=2) + "\n", encoding="utf-8")
+    return scores

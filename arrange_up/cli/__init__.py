@@ -63,6 +63,11 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
         "repair",
         "Make a nominal plan for PROBLEM robust by placing fixtures (thesis ch. 4).",
     ),
+    "rescore-cbst": (
+        "train",
+        "rescore_cbst",
+        "Measure a saved CBST MODEL's 8-fold CV and fresh-test scores again.",
+    ),
     "show": (
         "show",
         "show",

@@ -26,6 +26,7 @@ from arrange_up.cli.shared import (
     timeout_option,
 )
 from arrange_up.io.planfile import plan_document, write_json_atomic
+from arrange_up.model.problem import ArrangementProblem
 from arrange_up.parallel import available_cores
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import DEFAULT_MAX_NODES, DEFAULT_WEIGHT
@@ -40,6 +41,23 @@ def _status_line(stats: dict[str, Any]) -> str:
         f"simulated {stats['transitions_simulated']:>8}  best h "
         f"{'-' if best is None else f'{best:g}'}  {stats['elapsed']:6.1f} s"
     )
+
+
+def _check_model(problem: ArrangementProblem, model: str | None) -> None:
+    """Exit 2 when the cbst model (``None``: the shipped one for the problem's controller) is
+    unknown, unsound or trained under another controller than the problem's."""
+    # Lazy: only the cbst semantics needs scikit-learn (its import, with the model room, took
+    # 0.13 s measured, see arrange_up.up.engines); the planner imports it next anyway.
+    from arrange_up.cbst.choice import model_for
+
+    try:
+        model_for(problem, "default" if model is None else model)
+    except (LookupError, ValueError) as error:
+        fail(
+            f"--model {model}: {error}"
+            if model is not None
+            else f"{problem.source or problem.name}: {error}"
+        )
 
 
 @click.command()
@@ -91,7 +109,9 @@ def _status_line(stats: dict[str, Any]) -> str:
 @click.option(
     "--model",
     default=None,
-    help="CBST model (--semantics cbst): a shipped name or the .json card train-cbst wrote.",
+    help="CBST model (--semantics cbst): a shipped name or the .json card train-cbst wrote; "
+    "it must have been trained under the problem's controller [default: the shipped model "
+    "of the problem's controller].",
 )
 @click.option(
     "--output",
@@ -130,6 +150,8 @@ def plan(
     """
     check_semantics(semantics)
     loaded = load_problem(problem)
+    if semantics == "cbst":
+        _check_model(loaded, model)
     if workers is None:
         workers = 1 if semantics == "deterministic" else available_cores()
     try:

@@ -11,8 +11,9 @@ outcomes compare and hash equal and the search dedupes them.
 * **push**: the belief is mapped into the canonical "push toward +u" frame
   (:class:`~arrange_up.cbst.frame.CanonicalFrame`), the contact graph decides what moves
   (:func:`~arrange_up.cbst.contact_graph.analyse_push`), and every object of the compressed
-  train(s) gets its new box from the learned PREDICT (:func:`~arrange_up.cbst.model.load_model`)
-  composed from the wall back toward the paddle (PUSHTRANSOBJ): an object at depth ``k``
+  train(s) gets its new box from the learned PREDICT (a model trained under the problem's
+  controller: :func:`~arrange_up.cbst.choice.model_for`) composed from the wall back toward
+  the paddle (PUSHTRANSOBJ): an object at depth ``k``
   (``k`` objects from the wall, itself included) ends with ``u`` in
   ``[x_max - dx, x_max + max(slip, allowance_k)]``, ``x_max = wall - (k - 1/2) d`` (the
   thesis's ``b[next].x - d`` with ``next`` flush and as far forward as possible), ``v`` in
@@ -46,10 +47,11 @@ from pathlib import Path
 import numpy as np
 
 from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
+from arrange_up.cbst.choice import model_for
 from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
-from arrange_up.cbst.model import load_model
+from arrange_up.cbst.model import DEFAULT_MODEL
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
@@ -71,7 +73,9 @@ class CBSTSemantics:
     ``particles`` is 2: the planner sees an interval belief as its two corner
     pseudo-particles. ``seed`` and ``workers`` are accepted for the registry's signature and
     unused (predictions are deterministic and run in this process). ``model`` names the
-    learned model (a shipped name or a card path).
+    learned model (a shipped name, ``"default"`` for the shipped model of the problem's
+    controller, or a card path); a model trained under another controller than the
+    problem's is refused with ``ValueError`` (:func:`arrange_up.cbst.choice.model_for`).
     """
 
     name = "cbst"
@@ -87,7 +91,7 @@ class CBSTSemantics:
         particles: int = 2,
         seed: int = 0,
         workers: int = 1,
-        model: str | Path = "default",
+        model: str | Path = DEFAULT_MODEL,
     ) -> None:
         self.problem = problem
         self.particles = 2
@@ -95,7 +99,7 @@ class CBSTSemantics:
         self.workers = workers
         self.simulations = 0
         self.reasons: Counter[str] = Counter()
-        self.model = load_model(model)
+        self.model = model_for(problem, model)
         card = self.model.card_
         self.block_size = float(card["block_size"])
         self.paddle_size = tuple(float(v) for v in card["paddle_size"])

@@ -32,13 +32,16 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
   table.
 * ``TIMEOUT``: the ``timeout`` ran out. unified-planning never enforces timeouts; the engine
   watches the clock itself.
-* ``UNSUPPORTED_PROBLEM``: the problem is not an arrange-up problem; ``INTERNAL_ERROR``: the
-  planner failed, or reading the problem did. Both with a log message saying why.
+* ``UNSUPPORTED_PROBLEM``: the problem is not an arrange-up problem, or (``cbst``) the model
+  was trained under another controller than the problem's; ``INTERNAL_ERROR``: the planner
+  failed, or reading the problem did. Both with a log message saying why.
 
 Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` (default
 ``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000),
 ``model`` (``cbst`` only: a shipped model name or the card path of a model ``arrange-up
-train-cbst`` made; default the shipped one; it is loaded and checked when the engine is made).
+train-cbst`` made; default the shipped one for the problem's controller; it is loaded and
+checked when the engine is made, and a problem whose controller is not the model's is
+refused).
 Metrics hold the search statistics (expanded, generated, evaluated, pruned, elapsed, ...).
 
 **The reliability validator** (:class:`ArrangeUpReliability`) judges a plan by Monte Carlo
@@ -432,6 +435,13 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
             status = Status.INTERNAL_ERROR if arrangement.internal else Status.UNSUPPORTED_PROBLEM
             return result(status, logs=[LogMessage(LogLevel.ERROR, arrangement.message)])
 
+        if self._semantics == "cbst":
+            refusal = _model_refusal(arrangement, self._model)
+            if refusal is not None:
+                return result(
+                    Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, refusal)]
+                )
+
         deadline = None if timeout is None else started + max(0.0, float(timeout))
 
         def out_of_time() -> bool:
@@ -535,6 +545,18 @@ def _check_params(semantics: Any, particles: Any, seed: Any, max_nodes: Any, mod
             load_model(model)  # a model that does not load is refused when the engine is made
         except (LookupError, ValueError) as error:
             raise ValueError(f"arrange-up: model {model!r}: {error}") from None
+
+
+def _model_refusal(problem: ArrangementProblem, model: str | None) -> str | None:
+    """Why the cbst semantics' model (``None``: the shipped one for the problem's controller)
+    cannot plan ``problem`` (it was trained under another controller), or ``None``."""
+    from arrange_up.cbst.choice import model_for  # lazy: scikit-learn, see _check_params
+
+    try:
+        model_for(problem, "default" if model is None else model)
+    except (LookupError, ValueError) as error:
+        return f"arrange-up: {error}"
+    return None
 
 
 def _plan_to_up(

@@ -110,27 +110,45 @@ def test_unknown_model_name():
         load_model("no-such-model")
 
 
-def test_tune_reports_cv_and_test_rmse():
+def test_tune_reports_cv_rmse_and_r2_of_every_target():
     X, y = _data(240)
     groups = np.repeat(np.arange(120), 2)
     model, report = tune(
         X, y, groups, param_grid={"min_samples_leaf": [1, 4]}, n_estimators=5, cv=8, seed=0
     )
-    assert report["cv_folds"] == 8 and set(report["test_rmse"]) == set(TARGET_NAMES)
-    assert report["test_examples"] == 12 and report["train_examples"] == 108
+    assert report["cv_folds"] == 8 and report["examples"] == 120 and report["rows"] == 240
+    assert set(report["cv_rmse"]) == set(report["cv_r2"]) == set(TARGET_NAMES)
+    # dth is mostly one feature: out-of-fold predictions explain nearly all its variance
+    assert report["cv_r2"]["dth"] > 0.9 and report["cv_r2"]["dx"] > 0.0
     assert report["best_params"]["min_samples_leaf"] in (1, 4)
     assert isinstance(model, CBSTRegressor)
 
 
-def test_shipped_default_model_and_card():
-    model = load_model("default")
+def test_scores_are_rmse_and_the_coefficient_of_determination():
+    from arrange_up.cbst.model import _scores
+
+    y = np.array([[0.0, 1.0, 2.0, 0.0], [2.0, 1.0, 4.0, 0.0]])
+    mean = np.repeat(y.mean(axis=0, keepdims=True), 2, axis=0)
+    perfect, flat = _scores(y, y), _scores(y, mean)
+    assert perfect["r2"]["dx"] == 1.0 and perfect["rmse"]["dth"] == 0.0
+    assert flat["r2"]["dx"] == 0.0 and flat["rmse"]["dx"] == 1.0
+    assert flat["r2"]["slip"] == 0.0  # a constant target: nothing to explain
+
+
+@pytest.mark.parametrize("name", ["servo", "compliant"])
+def test_shipped_models_and_cards(name):
+    model = load_model(name)
     card = model.card_
+    assert card["controller"]["kind"] == name
     assert card["features"] == list(FEATURE_NAMES) and card["targets"] == list(TARGET_NAMES)
-    assert card["scores"]["thesis_test_rmse"] == THESIS_TEST_RMSE
+    scores = card["scores"]
+    assert scores["thesis_test_rmse"] == THESIS_TEST_RMSE and scores["cv_folds"] == 8
+    for key in ("cv_rmse", "cv_r2", "test_rmse", "test_r2"):
+        assert set(scores[key]) == set(TARGET_NAMES), key
+    assert scores["test"]["seed"] != card["data"]["seed"]
+    assert scores["test"]["rollouts_per_example"] == card["data"]["rollouts_per_example"]
     for key in ("examples", "rows", "rollouts_per_example", "seed"):
         assert key in card["data"]
-    assert set(card["scores"]["test_rmse"]) == set(TARGET_NAMES)
-    assert card["model"]["cv_folds"] == 8
     json.dumps(card)  # plain JSON
     # A typical row: a placed block (+-0.2 in, 15 deg) pushed alone against the wall.
     row = np.array([[0.05, 0.05, 3.0, 0.2, 0.2, 15.0, 0, 0, 0, 0.3, 0, 0]])
@@ -168,7 +186,7 @@ def test_load_by_name_from_an_installed_wheel_layout(tmp_path, monkeypatch):
     shipped.mkdir(parents=True)
     source = model_module.model_dir()  # the checkout's, or the installed wheel's
     for suffix in (".json", ".npz"):
-        shutil.copy(source / f"default{suffix}", shipped / f"wheel-only{suffix}")
+        shutil.copy(source / f"servo{suffix}", shipped / f"wheel-only{suffix}")
     card = json.loads((shipped / "wheel-only.json").read_text())
     card["arrays"]["file"] = "wheel-only.npz"
     (shipped / "wheel-only.json").write_text(json.dumps(card))
@@ -190,12 +208,16 @@ def test_train_cbst_end_to_end_in_one_process(tmp_path):
         seed=5,
         workers=2,
         output_dir=tmp_path,
+        test_examples=4,
         param_grid={"min_samples_leaf": [2, 4]},
         n_estimators=4,
         progress=lambda stage, done, total: stages.append((stage, done, total)),
     )
-    assert ("data", 16, 16) in stages and stages[-1] == ("fit", 1, 1)
-    assert card["data"]["examples"] == 16 and card["model"]["cv_folds"] == 8
-    assert (tmp_path / "default.data.jsonl").exists()
-    model = load_model(tmp_path / "default.json")
+    assert ("data", 16, 16) in stages and ("test data", 4, 4) in stages
+    assert stages[-1] == ("fit", 1, 1)
+    assert card["data"]["examples"] == 16 and card["scores"]["cv_folds"] == 8
+    assert card["scores"]["test"]["examples"] == 4 and card["scores"]["test"]["seed"] == 1
+    assert (tmp_path / "compliant.data.jsonl").exists()
+    assert (tmp_path / "compliant.test.jsonl").exists()
+    model = load_model(tmp_path / "compliant.json")
     assert model.predict(np.zeros((1, 12))).shape == (1, 4)

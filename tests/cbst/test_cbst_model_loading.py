@@ -3,6 +3,7 @@ usable by the planner and the unified-planning engine."""
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import shutil
@@ -14,9 +15,16 @@ import pytest
 import arrange_up.cbst.model as model_module
 from arrange_up.cbst.features import FEATURE_NAMES, Domain
 from arrange_up.cbst.model import CBSTRegressor, load_model, model_dir, save_model
-from arrange_up.io.domains import load
+from arrange_up.io.domains import load as load_domain
+from arrange_up.model.problem import Controller, ControllerKind
 from arrange_up.planning.planner import plan
 from arrange_up.transitions import make_semantics
+
+
+def load(name: str):
+    """A shipped problem under the servo controller, the one the model of one's own (a copy
+    of the shipped servo model) was trained under."""
+    return dataclasses.replace(load_domain(name), controller=Controller(kind=ControllerKind.SERVO))
 
 
 @pytest.fixture(scope="module")
@@ -125,7 +133,7 @@ def test_an_arrays_file_that_is_a_link_elsewhere_is_refused(tiny, tmp_path):
 def own_model(tmp_path_factory) -> Path:
     """The shipped model saved as a model of one's own (as train-cbst writes one)."""
     folder = tmp_path_factory.mktemp("own")
-    shipped = load_model("default")
+    shipped = load_model("servo")
     card = {k: v for k, v in shipped.card_.items() if k not in ("format", "name", "arrays")}
     return save_model(shipped, card, folder, "mine")
 
@@ -145,7 +153,7 @@ def test_a_model_is_refused_where_it_cannot_be_used(own_model, tmp_path):
         make_semantics("deterministic", problem, model=own_model)
     with pytest.raises(LookupError, match="unknown CBST model"):
         plan(problem, semantics="cbst", model=tmp_path / "none.json")
-    assert (model_dir() / "default.json").is_file()
+    assert (model_dir() / "servo.json").is_file() and (model_dir() / "compliant.json").is_file()
 
 
 def test_the_engine_takes_a_model_parameter(own_model, tmp_path):

@@ -10,12 +10,16 @@ from click.testing import CliRunner
 from arrange_up.cli import main
 from arrange_up.io.resources import shipped_dir
 
-CARD = shipped_dir("semantics", "the shipped semantics") / "cbst" / "default.json"
+CARD = shipped_dir("semantics", "the shipped semantics") / "cbst" / "servo.json"
 
 
 def test_a_model_card_plans_and_is_recorded_in_the_plan_file(tmp_path: Path) -> None:
     out = tmp_path / "b2.json"
-    args = ["plan", "blocks-2", "--semantics", "cbst", "--model", str(CARD), "-o", str(out)]
+    # the servo's model plans a problem of the servo
+    problem = tmp_path / "blocks-2-servo.yaml"
+    source = shipped_dir("domains", "the shipped domains") / "blocks-2.yaml"
+    problem.write_text(source.read_text() + "controller: {kind: servo}\n")
+    args = ["plan", str(problem), "--semantics", "cbst", "--model", str(CARD), "-o", str(out)]
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 0, result.output
     document = json.loads(out.read_text())

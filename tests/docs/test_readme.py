@@ -57,8 +57,9 @@ SCALED_DOWN: dict[str, str] = {
     "arrange-up experiment fixtures --plans 5 --particles 10,40,150": (
         "arrange-up experiment fixtures --problems down-push --plans 1 --particles 10 --rollouts 5"
     ),
-    "arrange-up train-cbst --examples 1800 --rollouts-per-example 100": (
-        "arrange-up train-cbst --examples 10 --rollouts-per-example 2"
+    "arrange-up train-cbst --controller compliant --rollouts-per-example 1000": (
+        "arrange-up train-cbst --controller compliant --examples 10 --rollouts-per-example 2"
+        " --test-examples 2"
     ),
     "arrange-up show blocks-3 --plan b3.json --rollouts 30 -o blocks-3-storyboard.png "
     "--animate blocks-3.gif": (
