@@ -342,11 +342,11 @@ def plan_problem_mismatch(document: Mapping[str, Any], problem: ArrangementProbl
     controller = document.get("controller", legacy) if isinstance(document, Mapping) else None
     kind = controller.get("kind") if isinstance(controller, Mapping) else controller
     if controller is not None and kind != problem.controller.kind.value:
+        why = " (it names no controller: it was made when the servo was every problem's)"
         return (
             f"it was planned under the {kind if isinstance(kind, str) else _shown(kind)} "
-            f"controller; problem {problem.name!r} uses "
-            f"the {problem.controller.kind.value} one (a plan file without a 'controller' was "
-            "made under the servo)"
+            f"controller; problem {problem.name!r} uses the {problem.controller.kind.value} "
+            f"one{why if controller is legacy else ''}"
         )
     if recorded.get("hash") not in (None, problem_hash(problem)):
         return (

@@ -442,11 +442,7 @@ class ActionGenerator:
             half = interval.half[axis]
             if travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
-            elif (
-                abs(target[axis] - interval.center[axis]) + half
-                > self.problem.goal.tolerance[axis] + 1e-9
-                and travel + half > MIN_PUSH
-            ):
+            elif not self._inside_goal(interval, target, axis) and travel + half > MIN_PUSH:
                 # Narrowing: the centre is (about) on target but the spread misses the goal.
                 # The push ends where the nominal part would sit at its target, so the states
                 # behind it are swept up to the target and those ahead are left alone; a push
@@ -475,15 +471,19 @@ class ActionGenerator:
     def _settled(self, parts: tuple[str, ...], belief: IntervalBelief, axis: int) -> bool:
         """Whether every one of ``parts`` lies within its goal interval along ``axis`` in every
         state of ``belief`` (its interval inside the target +- the tolerance)."""
-        tolerance = self.problem.goal.tolerance[axis] + 1e-9
         for part in parts:
             target = self.place_target(part, belief)
             interval = belief.get(part)
             if target is None or interval is None:
                 return False
-            if abs(interval.center[axis] - target[axis]) + interval.half[axis] > tolerance:
+            if not self._inside_goal(interval, target, axis):
                 return False
         return True
+
+    def _inside_goal(self, interval, target: Pose, axis: int) -> bool:
+        """Whether ``interval`` lies inside ``target`` +- the goal tolerance along ``axis``."""
+        tolerance = self.problem.goal.tolerance[axis] + 1e-9
+        return abs(interval.center[axis] - target[axis]) + interval.half[axis] <= tolerance
 
     def _solve_distance(
         self, push: Push, name: str, axis: int, sign: int, travel: float, belief: IntervalBelief
