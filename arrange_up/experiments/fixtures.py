@@ -623,15 +623,22 @@ def markdown_table(summary: Sequence[SummaryRow]) -> str:
 def plot_fixture_experiment(rows: Sequence[dict[str, str]], output_dir: Path) -> list[Path]:
     """Draw ``fixtures-overview.png`` and one ``fixtures-<problem>.png`` per problem of
     ``rows`` (CSV rows, see :func:`select_rows`) into ``output_dir``; returns the paths written
-    (overview first)."""
+    (overview first). A problem given as a file is named by the file's stem
+    (``fixtures-tz-variant.png`` for ``/some/dir/tz-variant.yaml``)."""
     summary = summarize(rows)
     problems = list(dict.fromkeys(s.problem for s in summary))
     output_dir = Path(output_dir)
     written = [_plot_overview(summary, problems, output_dir / "fixtures-overview.png")]
     for problem in problems:
         rows = [s for s in summary if s.problem == problem]
-        written.append(_plot_problem(problem, rows, output_dir / f"fixtures-{problem}.png"))
+        png = output_dir / f"fixtures-{Path(problem).stem if _is_file(problem) else problem}.png"
+        written.append(_plot_problem(problem, rows, png))
     return written
+
+
+def _is_file(problem: str) -> bool:
+    """Whether ``problem`` (as the CSV records it) names a problem file, not a shipped one."""
+    return "/" in problem or "\\" in problem or Path(problem).suffix in (".yaml", ".yml", ".pddl")
 
 
 def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path) -> Path:

@@ -19,6 +19,7 @@ from arrange_up.experiments.fixtures import (
     read_rows,
     summarize,
 )
+from arrange_up.io.domains import resolve_problem
 
 TINY = {"plans": 1, "particles": (3, 5), "rollouts": 5, "workers": 1, "ablation": False}
 
@@ -273,3 +274,19 @@ def test_turning_the_ablation_on_later_measures_only_its_rows(tmp_path, monkeypa
     fixture_experiment(tmp_path, problems=("down-push",), **{**args, "ablation": True})
     assert calls == [False]
     assert rows(path)[:2] == first and rows(path)[2]["stage"] == "ablation"
+
+
+def test_a_problem_given_as_a_file_gets_a_picture_named_after_the_file(tmp_path):
+    # The CSV records the path; the picture is named by the file's stem, in the output folder.
+    source = resolve_problem("down-push").read_text(encoding="utf-8")
+    problem_file = tmp_path / "problems" / "down-push-copy.yaml"
+    problem_file.parent.mkdir()
+    problem_file.write_text(source.replace("name: down-push", "name: down-push-copy"))
+    out = tmp_path / "out"
+    args = ["--plans", "1", "--particles", "3", "--rollouts", "5", "--workers", "1"]
+    result = invoke(
+        *args, "--no-ablation", "--problems", str(problem_file), "--output-dir", str(out)
+    )
+    assert result.exit_code == 0, result.output
+    assert (out / "fixtures-down-push-copy.png").stat().st_size > 0
+    assert f"| {problem_file} | nominal |" in result.output
