@@ -136,7 +136,7 @@ def animate_plan(
         if k == 0:
             title = "start"
         else:
-            draw_action(ax, problem, actions[k - 1], t)
+            draw_action(ax, problem, actions[k - 1], t, travel=data["travel"][k - 1])
             title = f"action {k}/{len(actions)}: {describe(actions[k - 1], problem)}"
             if scene.nominal_failed:
                 title += " (nominal failed)"

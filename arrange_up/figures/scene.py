@@ -250,10 +250,19 @@ def draw_scene(ax: Axes, problem: ArrangementProblem, scene: Scene) -> None:
         )
 
 
-def draw_action(ax: Axes, problem: ArrangementProblem, action: Action, t: float = 1.0) -> None:
+def draw_action(
+    ax: Axes,
+    problem: ArrangementProblem,
+    action: Action,
+    t: float = 1.0,
+    *,
+    travel: float | None = None,
+) -> None:
     """Draw ``action``: a place's commanded pose dotted black; a push's manipulator ``t`` of
-    the way along the commanded push, with an arrow from its approach pose as long as the
-    commanded distance; a pick as a note."""
+    the way along its ``travel`` (how far it went in the noise-free push; the commanded
+    distance when None), with an arrow from its approach pose as long as the commanded
+    distance (under the compliant controller a resisted push stops short of the arrow's
+    head); a pick as a note."""
     if isinstance(action, Place):
         spec = problem.object(action.obj)
         render.draw_object(
@@ -263,8 +272,9 @@ def draw_action(ax: Axes, problem: ArrangementProblem, action: Action, t: float 
         spec = problem.object(action.manipulator)
         ux, uy = rotate(spec.push_direction, action.pose[2])
         dx, dy = ux * action.distance, uy * action.distance
+        went = t * (action.distance if travel is None else travel)
         x, y, theta = action.pose
-        render.draw_object(ax, spec, (x + t * dx, y + t * dy, theta), color="0.15", zorder=5)
+        render.draw_object(ax, spec, (x + went * ux, y + went * uy, theta), color="0.15", zorder=5)
         ax.annotate(
             "",
             xy=(x + dx, y + dy),

@@ -37,7 +37,13 @@ from arrange_up.figures.scene import (
     style_axes,
 )
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.model.world import Action, WorldState, nominal_initial_state, nominal_noise
+from arrange_up.model.world import (
+    Action,
+    Push,
+    WorldState,
+    nominal_initial_state,
+    nominal_noise,
+)
 from arrange_up.physics.simulation import simulate
 from arrange_up.transitions import make_semantics
 
@@ -56,19 +62,25 @@ def storyboard_data(
     """Compute what a storyboard draws: nominal states, predicted beliefs, rollout states.
 
     Returns a dict with ``nominal`` (states before and after each action; ``None`` after a
-    failure), ``beliefs`` (the semantics' predicted belief before and after each action;
-    ``None`` where it made no prediction) and ``rollouts`` (for each rollout, its states, cut
-    short where it failed).
+    failure), ``travel`` (for each action, how far the manipulator travelled in the noise-free
+    push, which stops short of the commanded distance when the compliant controller stalls;
+    ``None`` for a place, a pick or a failed action), ``beliefs`` (the semantics' predicted
+    belief before and after each action; ``None`` where it made no prediction) and
+    ``rollouts`` (for each rollout, its states, cut short where it failed).
     """
     nominal: list[WorldState | None] = [nominal_initial_state(problem)]
+    travel: list[float | None] = []
     for action in actions:
         state = nominal[-1]
+        travel.append(None)
         if state is None:
             nominal.append(None)
             continue
         try:
             outcome = simulate(problem, state, action, nominal_noise(problem))
             nominal.append(outcome.state if outcome.ok else None)
+            if outcome.ok and isinstance(action, Push):
+                travel[-1] = outcome.manipulator_travel
         except ValueError:
             nominal.append(None)
 
@@ -85,7 +97,7 @@ def storyboard_data(
         traces.append(trace_rollout(problem, actions, seed, i))
         if progress is not None:
             progress(i + 1, rollouts)
-    return {"nominal": nominal, "beliefs": beliefs, "rollouts": traces}
+    return {"nominal": nominal, "travel": travel, "beliefs": beliefs, "rollouts": traces}
 
 
 def draw_storyboard(
@@ -171,7 +183,7 @@ def _draw_panel(ax, problem: ArrangementProblem, data, actions, k: int) -> None:
     draw_scene(ax, problem, scene)
     title = "start" if k == 0 else f"{k}. {describe(actions[k - 1], problem)}"
     if k > 0:
-        draw_action(ax, problem, actions[k - 1])
+        draw_action(ax, problem, actions[k - 1], travel=data["travel"][k - 1])
         if scene.nominal_failed:
             title += " (nominal failed)"
         if scene.no_prediction:

@@ -119,3 +119,16 @@ def test_panel_titles_quote_the_problems_units():
     assert describe(PLAN[0], mm) == "place A at (103.84, 23.16, 0)"
     assert describe(PLAN[1], mm) == "push 13.90 mm"
     assert describe(Pick("A"), mm) == "pick A"
+
+
+def test_a_stalled_push_is_drawn_where_the_paddle_stopped():
+    # Under the compliant controller a push resisted by the block stops short of its commanded
+    # distance: the data record how far the paddle went, which the pictures draw.
+    problem = tiny("one-block")  # the default, compliant controller
+    data = storyboard_data(problem, PLAN, rollouts=0)
+    pushes = [k for k, action in enumerate(PLAN) if isinstance(action, Push)]
+    assert [data["travel"][k] is None for k in range(len(PLAN))] == [
+        k not in pushes for k in range(len(PLAN))
+    ]
+    # PLAN's distances are the servo's (a push into a wall): the compliant paddle stops short.
+    assert all(0 < data["travel"][k] < PLAN[k].distance for k in pushes)
