@@ -707,6 +707,15 @@ def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path
     return png
 
 
+def _reliability_bars(ax, rows: Sequence[SummaryRow], **style) -> None:
+    """The mean reliability of evaluated ``rows`` against particles, with min–max bars."""
+    xs = [s.particles for s in rows]
+    ys = [100 * s.reliability for s in rows]
+    low = [y - 100 * s.low for y, s in zip(ys, rows, strict=True)]
+    high = [100 * s.high - y for y, s in zip(ys, rows, strict=True)]
+    ax.errorbar(xs, ys, yerr=[low, high], capsize=3, **style)
+
+
 def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
     plt = pyplot()
     nominal = rows[0]
@@ -732,33 +741,13 @@ def _plot_problem(problem: str, rows: Sequence[SummaryRow], png: Path) -> Path:
         )
     shown = [s for s in repaired if s.evaluated]
     if shown:
-        xs = [s.particles for s in shown]
-        ys = [100 * s.reliability for s in shown]
-        ax_rel.errorbar(
-            xs,
-            ys,
-            yerr=[
-                [y - 100 * s.low for y, s in zip(ys, shown, strict=True)],
-                [100 * s.high - y for y, s in zip(ys, shown, strict=True)],
-            ],
-            marker="o",
-            capsize=3,
-            color=COLOR,
-            label="repaired (mean, min–max)",
-        )
+        _reliability_bars(ax_rel, shown, marker="o", color=COLOR, label="repaired (mean, min–max)")
     if ablation:
-        xs = [s.particles for s in ablation]
-        ys = [100 * s.reliability for s in ablation]
-        ax_rel.errorbar(
-            xs,
-            ys,
-            yerr=[
-                [y - 100 * s.low for y, s in zip(ys, ablation, strict=True)],
-                [100 * s.high - y for y, s in zip(ys, ablation, strict=True)],
-            ],
+        _reliability_bars(
+            ax_rel,
+            ablation,
             marker="s",
             ls="--",
-            capsize=3,
             color=ABLATION_COLOR,
             label=f"{ABLATION_LABEL} (mean, min–max)",
         )

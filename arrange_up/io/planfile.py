@@ -39,7 +39,7 @@ from typing import Any
 
 from arrange_up.io.files import undecodable_place
 from arrange_up.io.validation import angle_problem
-from arrange_up.io.yaml_settings import SERVO_KEYS
+from arrange_up.io.yaml_settings import SERVO_KEYS, controller_factors
 from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import (
     ArrangementProblem,
@@ -165,17 +165,9 @@ def controller_to_json(problem: ArrangementProblem) -> dict[str, Any]:
     units (omitted keys were left at their defaults; the servo's only keys are its speed and
     force)."""
     controller = problem.controller
-    length = problem.units.length_factor
-    scale = {
-        "kp": 1.0,
-        "kp_angle": length * length / problem.units.angle_factor,
-        "speed": length,
-        "force": length,
-        "torque": length * length,
-    }
     data: dict[str, Any] = {"kind": controller.kind.value}
     servo = controller.kind is ControllerKind.SERVO
-    for key, factor in scale.items():
+    for key, factor in controller_factors(problem.units).items():
         value = getattr(controller, key)
         if value is not None and not (servo and key not in SERVO_KEYS):
             data[key] = _round(value / factor)

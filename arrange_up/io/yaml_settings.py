@@ -15,9 +15,11 @@ from arrange_up.model.problem import (
     PlanningHints,
     Uncertainty,
 )
+from arrange_up.model.units import Units
 
 __all__ = [
     "CONTROLLER_KEYS",
+    "controller_factors",
     "PLANNING_KEYS",
     "PUSH_DIRECTIONS",
     "SERVO_KEYS",
@@ -30,6 +32,23 @@ PLANNING_KEYS = ("place_offsets", "place_angles", "push_distances", "push_direct
 CONTROLLER_KEYS = ("kind", "kp", "kp_angle", "speed", "force", "torque")
 #: Keys the servo controller reads (the others tune the compliant controller only).
 SERVO_KEYS = ("kind", "speed", "force")
+
+
+def controller_factors(units: Units) -> dict[str, float]:
+    """For each numeric ``controller:`` key, the factor from the file's units to internal ones
+    (a file's value times it): ``kp`` in mass/s^2 needs none, ``speed`` is a length per second,
+    ``force`` a mass x length/s^2, ``torque`` a mass x length^2/s^2 and ``kp_angle`` a torque
+    per angle unit."""
+    length = units.length_factor
+    return {
+        "kp": 1.0,
+        "kp_angle": length * length / units.angle_factor,
+        "speed": length,
+        "force": length,
+        "torque": length * length,
+    }
+
+
 UNCERTAINTY_KEYS = ("place", "push", "friction", "part_density", "manipulator_density")
 
 
@@ -141,10 +160,8 @@ class SettingsReader(NodeReader):
 
     # -- the push controller --------------------------------------------------------------------
     def controller(self, root: Node) -> Controller | None:
-        """The ``controller:`` mapping (``docs/problem-format.md``), converted to internal units:
-        ``kp`` in mass/s^2 needs no conversion, ``speed`` is a length per second, ``force`` a
-        mass x length/s^2, ``torque`` a mass x length^2/s^2 and ``kp_angle`` a torque per angle
-        unit."""
+        """The ``controller:`` mapping (``docs/problem-format.md``), converted to internal units
+        by :func:`controller_factors`."""
         if not root.has("controller"):
             return DEFAULT_CONTROLLER
         node = root.child("controller")
@@ -183,16 +200,8 @@ class SettingsReader(NodeReader):
                         f"reads {', '.join(SERVO_KEYS)}",
                     )
                     ok = False
-        length = self.units.length_factor
-        scale = {
-            "kp": 1.0,
-            "kp_angle": length * length / self.units.angle_factor,
-            "speed": length,
-            "force": length,
-            "torque": length * length,
-        }
         values: dict[str, Any] = {}
-        for key, factor in scale.items():
+        for key, factor in controller_factors(self.units).items():
             if not node.has(key):
                 continue
             child = node.child(key)
