@@ -200,11 +200,8 @@ class ActionGenerator:
     def candidates(self, belief: IntervalBelief) -> list[Action]:
         """Every applicable candidate action of ``belief`` (preconditions hold), in a fixed
         order: places, then pushes, then picks."""
-        actions: list[Action] = []
-        actions.extend(self.places(belief))
-        actions.extend(self.pushes(belief))
-        actions.extend(self.picks(belief))
-        return actions
+        places = self.places(belief)
+        return [*places, *self.pushes(belief, places), *self.picks(belief)]
 
     # -- place -----------------------------------------------------------------------------
     def place_target(self, name: str, belief: IntervalBelief) -> Pose | None:
@@ -271,13 +268,16 @@ class ActionGenerator:
         )
 
     # -- push ------------------------------------------------------------------------------
-    def pushes(self, belief: IntervalBelief) -> list[Push]:
+    def pushes(self, belief: IntervalBelief, places: list[Place] | None = None) -> list[Push]:
+        """The push candidates of ``belief``; ``places``, its place candidates if the caller
+        has them already (:meth:`candidates`), saves computing them again."""
         on_table = self._shadows(belief)
         # The ladder for parts without a goal position only when a goal part cannot be placed:
         # otherwise the goal-directed actions make progress, and the ladder only widens the
         # search (relative matings expanded 13 times the nodes with it always on).
+        placeable = {a.obj for a in (self.places(belief) if places is None else places)}
         ladder = any(
-            spec.name not in belief and not self.places(belief, only=spec.name)
+            spec.name not in belief and spec.name not in placeable
             for spec in self.problem.parts
             if spec.name in self.problem.goal.parts
         )
