@@ -96,6 +96,21 @@ class SettingsReader(NodeReader):
             )
         return Uncertainty(**values) if ok else None
 
+    def _known_keys(self, node: Node, keys: tuple[str, ...], what: str, why: str = "") -> bool:
+        """Report every key of mapping ``node`` not among ``keys`` as an error (an unknown
+        ``what``, with the nearest known key and ``why`` it is not just a warning); True if
+        there was none."""
+        ok = True
+        for key_node, _ in node.entries():
+            if key_node.value not in keys:
+                self.error(
+                    key_node,
+                    f"unknown {what} {key_node.value!r}{suggest(key_node.value, keys)}; "
+                    f"expected one of {', '.join(keys)}{why}",
+                )
+                ok = False
+        return ok
+
     # -- planning hints -------------------------------------------------------------------------
     def planning(self, root: Node) -> PlanningHints | None:
         if not root.has("planning"):
@@ -107,17 +122,12 @@ class SettingsReader(NodeReader):
             return None
         if node.is_null:
             return PlanningHints()
-        ok = True
-        for key_node, _ in node.entries():
-            if key_node.value not in PLANNING_KEYS:
-                self.error(
-                    key_node,
-                    f"unknown planning hint {key_node.value!r}"
-                    f"{suggest(key_node.value, PLANNING_KEYS)}; expected one of "
-                    f"{', '.join(PLANNING_KEYS)} (a misspelt hint would silently change "
-                    "planning)",
-                )
-                ok = False
+        ok = self._known_keys(
+            node,
+            PLANNING_KEYS,
+            "planning hint",
+            " (a misspelt hint would silently change planning)",
+        )
         hints: dict[str, Any] = {}
         units = self.units
         if node.has("place_offsets"):
@@ -169,17 +179,8 @@ class SettingsReader(NodeReader):
             node, "a mapping {kind: compliant | servo, ...} (" + ", ".join(CONTROLLER_KEYS) + ")"
         ):
             return None
-        ok = True
-        for key_node, _ in node.entries():
-            if key_node.value not in CONTROLLER_KEYS:
-                # An error, not a warning: a misspelt gain would silently change the physics.
-                self.error(
-                    key_node,
-                    f"unknown controller key {key_node.value!r}"
-                    f"{suggest(key_node.value, CONTROLLER_KEYS)}; expected one of "
-                    f"{', '.join(CONTROLLER_KEYS)}",
-                )
-                ok = False
+        # An error, not a warning: a misspelt gain would silently change the physics.
+        ok = self._known_keys(node, CONTROLLER_KEYS, "controller key")
         kinds = tuple(kind.value for kind in ControllerKind)
         kind: ControllerKind | None = DEFAULT_CONTROLLER.kind
         if node.has("kind"):
