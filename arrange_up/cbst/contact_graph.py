@@ -60,7 +60,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from itertools import islice
 
 import networkx as nx
 
@@ -297,12 +296,38 @@ def maximal_paths(graph: nx.DiGraph) -> list[tuple[object, ...]]:
     fixed order). Raises :class:`Unpredictable` beyond :data:`MAX_PATHS` paths."""
     if WALL not in graph:
         return []
-    paths = [tuple(p) for p in islice(nx.all_simple_paths(graph, ROBOT, WALL), MAX_PATHS + 1)]
-    if len(paths) > MAX_PATHS:
-        raise Unpredictable("too many contact paths to analyse")
-    sets = [frozenset(p) for p in paths]
-    keep = [p for p, s in zip(paths, sets, strict=True) if not any(s < other for other in sets)]
-    return sorted(set(keep), key=lambda p: (-len(p), [repr(n) for n in p]))
+    # A path contained in another is strictly shorter, so each is tested against the longer
+    # paths kept so far only.
+    paths = sorted(set(_paths_to_wall(graph)), key=lambda p: (-len(p), [repr(n) for n in p]))
+    kept: list[tuple[object, ...]] = []
+    kept_sets: list[frozenset[object]] = []
+    for path in paths:
+        members = frozenset(path)
+        if not any(members < longer for longer in kept_sets):
+            kept.append(path)
+            kept_sets.append(members)
+    return kept
+
+
+def _paths_to_wall(graph: nx.DiGraph) -> list[tuple[object, ...]]:
+    """Every ``ROBOT -> WALL`` path of the contact graph, by a depth-first walk over its
+    adjacency. Every edge points forward along the push (an object's contacts are only with
+    what lies ahead of it), so the graph is acyclic and every path is simple; the generic
+    simple-path enumeration of networkx spent most of a CBST push's analysis on the
+    bookkeeping that this needs not."""
+    successors = {node: tuple(adjacent) for node, adjacent in graph.adj.items()}
+    paths: list[tuple[object, ...]] = []
+    stack: list[tuple[object, ...]] = [(ROBOT,)]
+    while stack:
+        path = stack.pop()
+        for nxt in successors[path[-1]]:
+            if nxt is WALL:
+                paths.append((*path, WALL))
+                if len(paths) > MAX_PATHS:
+                    raise Unpredictable("too many contact paths to analyse")
+            elif nxt not in path:
+                stack.append((*path, nxt))
+    return paths
 
 
 # -- PUSHTRANS (structure) -----------------------------------------------------------------------

@@ -161,6 +161,7 @@ class _OrderingFilter:
         self.targets = {p: tuple(goal.targets[k]) for k, p in enumerate(goal.parts)}
         self.pairs: list[tuple[str, str, int]] = []  # (a, b, axis): goal has a before b on axis
         self._place_cache: dict[str, list] = {}
+        self._goal_overlaps: dict[tuple[str, int, str], bool] = {}
         self._pairs_blocking = None
         if goal.reference is not None:
             return
@@ -205,17 +206,28 @@ class _OrderingFilter:
         towards its goal, and between two overlapping positions ``q`` keeps overlapping.
         """
         half = self.generator.place_unc
-        none = (0.0, 0.0, 0.0)
         found = []
         for k, pose in enumerate(self._candidates(part, intervals)):
             candidate = (part, pose, half)
             if not any(
-                self.checker.shadows_overlap(candidate, (q, iv.center, iv.half))
-                and self.checker.shadows_overlap(candidate, (q, self.targets[q], none))
+                self._meets_goal(part, k, pose, q)
+                and self.checker.shadows_overlap(candidate, (q, iv.center, iv.half))
                 for q, iv in placed
             ):
                 found.append(k)
         return found
+
+    def _meets_goal(self, part: str, k: int, pose, q: str) -> bool:
+        """Whether ``part``'s place candidate ``k`` (at ``pose``) overlaps ``q``'s goal
+        footprint; both are fixed for an absolute goal, so each answer is computed once."""
+        key = (part, k, q)
+        meets = self._goal_overlaps.get(key)
+        if meets is None:
+            meets = self.checker.shadows_overlap(
+                (part, pose, self.generator.place_unc), (q, self.targets[q], (0.0, 0.0, 0.0))
+            )
+            self._goal_overlaps[key] = meets
+        return meets
 
     def _candidates(self, part: str, intervals) -> list:
         """``part``'s place candidates; for an absolute goal they never change, so cached."""
