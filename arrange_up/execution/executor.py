@@ -88,11 +88,12 @@ def scaled_problem(problem: ArrangementProblem, scale: float) -> ArrangementProb
 class SimulatedExecutor:
     """The physics as the robot of one episode.
 
-    Everything random derives from ``numpy.random.default_rng([seed, episode])``: the true
-    initial state (as a rollout draws it, from the initial intervals), then per action its
-    noise and then its observation's noise. ``scale`` widens the world's noise beyond the
-    problem's model (:func:`scaled_problem`); ``landing`` is the rollouts' rule for a paddle put
-    down onto a part.
+    The world derives from ``numpy.random.default_rng([seed, episode])``: the true initial
+    state (as a rollout draws it, from the initial intervals), then each action's noise; the
+    observations' noise from a stream of its own, so the same episode meets the same world
+    whatever it senses (open and closed loop are paired). ``scale`` widens the world's noise
+    beyond the problem's model (:func:`scaled_problem`); ``landing`` is the rollouts' rule for
+    a paddle put down onto a part.
     """
 
     def __init__(
@@ -109,6 +110,7 @@ class SimulatedExecutor:
         self.sensor = sensor
         self.rollouts = Rollouts(self.world, (), landing=landing)
         self.rng = np.random.default_rng([seed, episode])
+        self.sense_rng = np.random.default_rng([seed, episode, 0x5E45E])
         frame = AngleFrame.of(self.world)
         self.state: WorldState = sample_initial_particles(
             self.world, 1, self.rng, frame=frame
@@ -123,4 +125,4 @@ class SimulatedExecutor:
         assert step.outcome is not None
         self.state = step.state
         self.trace.append(self.state)
-        return self.sensor.observe(action, step.outcome, self.rng)
+        return self.sensor.observe(action, step.outcome, self.sense_rng)

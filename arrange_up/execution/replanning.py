@@ -203,9 +203,10 @@ class ClosedLoop:
             if update.failure is not None:
                 failures.append(update.failure)
             estimate: float | None = None
-            if remaining:
+            # The estimate only decides whether to replan: none when no replan is left.
+            if remaining and len(replans) < s.max_replans:
                 estimate = self._plan_rate(belief, remaining, rng)
-                if estimate < s.threshold and len(replans) < s.max_replans:
+                if estimate < s.threshold:
                     found = self._replan(
                         belief, len(executed), estimate, episode, len(replans), rng
                     )

@@ -1,0 +1,117 @@
+"""Closed loop against open loop, on the same simulated worlds (issue 16's targets).
+
+    python benchmarks/closed_loop.py --problems tz-mating --episodes 20
+    python benchmarks/closed_loop.py --problems blocks-4 --noise-scale 2 --plan-semantics particles
+    python benchmarks/closed_loop.py --problems tz-mating,create-a-t --episodes 200 --output-dir out
+
+For each problem: a first plan (``--plan-semantics``: ``deterministic`` gives the nominal plan,
+the open-loop comparator of the mating problems; ``particles`` a particle plan), then the same
+episodes (episode i's world drawn from (seed, i), noise ``--noise-scale`` times the model's)
+run twice: open loop (the plan executed as it is: no replans, no sensing) and closed loop
+(``--sense``, replanning with ``--semantics`` / ``--particles`` / ``--max-nodes`` /
+``--replan-budget``). The two rates are therefore paired. Every episode is appended to a
+``.jsonl`` record per problem and mode in ``--output-dir`` (re-running resumes), and the summary
+of each pair to ``closed_loop.json`` there (merged with the problems already in it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from arrange_up.execution.episodes import run_episodes
+from arrange_up.execution.replanning import ClosedLoopSettings
+from arrange_up.io.domains import load
+from arrange_up.planning.planner import plan
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--problems", default="tz-mating")
+    parser.add_argument("--episodes", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--sense", default="paddle")
+    parser.add_argument("--noise-scale", type=float, default=1.0)
+    parser.add_argument("--plan-semantics", default="deterministic")
+    parser.add_argument("--plan-particles", type=int, default=10)
+    parser.add_argument("--semantics", default="deterministic")
+    parser.add_argument("--particles", type=int, default=10)
+    parser.add_argument("--max-nodes", type=int, default=300)
+    parser.add_argument("--replan-budget", type=float, default=30.0)
+    parser.add_argument("--filter-particles", type=int, default=64)
+    parser.add_argument("--output-dir", type=Path, default=Path("closed-loop-results"))
+    args = parser.parse_args(argv)
+    out = args.output_dir
+    out.mkdir(parents=True, exist_ok=True)
+    summary_path = out / "closed_loop.json"
+    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    for name in [p for p in args.problems.split(",") if p]:
+        problem = load(name)
+        first = plan(
+            problem, semantics=args.plan_semantics, particles=args.plan_particles, seed=args.seed
+        )
+        if not first.solved:
+            print(f"{name}: no first plan ({first.reason})", flush=True)
+            continue
+        actions = first.actions or ()
+        closed = ClosedLoopSettings(
+            filter_particles=args.filter_particles,
+            semantics=args.semantics,
+            particles=args.particles,
+            max_nodes=args.max_nodes,
+            budget=args.replan_budget,
+        )
+        tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
+        row = {}
+        for mode, sense, settings in (
+            ("open", "none", ClosedLoopSettings(filter_particles=1, max_replans=0)),
+            ("closed", args.sense, closed),
+        ):
+            label = tag if mode == "open" else f"{tag}.{args.semantics}{args.particles}"
+            result = run_episodes(
+                problem,
+                actions,
+                sense=sense,
+                episodes=args.episodes,
+                seed=args.seed,
+                scale=args.noise_scale,
+                settings=settings,
+                record=out / f"{label}.{mode}.jsonl",
+                progress=lambda e, mode=mode, name=name: print(
+                    f"{name} {mode} episode {e.episode}: {'ok' if e.success else e.failure.kind}"
+                    f" ({len(e.replans)} replans)",
+                    flush=True,
+                ),
+            )
+            data = result.to_json()
+            row[mode] = {
+                "successes": data["successes"],
+                "trials": data["trials"],
+                "rate": data["rate"],
+                "interval": data["interval"],
+                "replans": data["replans"],
+                "model_failures": data["model_failures"],
+                "stopped": data["stopped"],
+                "failures": data["failures"],
+                "settings": data["settings"],
+                "sense": sense,
+            }
+        row["plan"] = {"semantics": args.plan_semantics, "actions": len(actions)}
+        row["noise_scale"] = args.noise_scale
+        summary[f"{tag}.{args.semantics}{args.particles}"] = row
+        summary_path.write_text(json.dumps(summary, indent=2) + "\n")
+        o, c = row["open"], row["closed"]
+        print(
+            f"{name}: open loop {o['successes']}/{o['trials']} ({100 * o['rate']:.1f}%), "
+            f"closed loop {c['successes']}/{c['trials']} ({100 * c['rate']:.1f}%, "
+            f"{c['replans']['per_episode']:.2f} replans per episode, median "
+            f"{c['replans']['seconds']['median']} s per replan)",
+            flush=True,
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
