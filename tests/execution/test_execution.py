@@ -208,3 +208,13 @@ def test_the_execute_command_reports_rate_replans_and_failures(blocks2, tmp_path
     assert bad.exit_code == 2 and "sonar" in bad.output
     unknown = runner.invoke(main, ["execute", "blocks-2", "--semantics", "magic"])
     assert unknown.exit_code == 2 and "unknown semantics" in unknown.output
+
+
+def test_the_fake_robot_example_runs_the_loop(capsys):
+    import runpy
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "fake_robot.py"
+    runpy.run_path(str(example), run_name="__main__")
+    printed = capsys.readouterr().out
+    assert "push" in printed and "stopped: " in printed
