@@ -180,6 +180,7 @@ class ClosedLoopResult:
                 "total": len(times),
                 "per_episode": self.mean_replans,
                 "solved": solved,
+                "adopted": sum(r.adopted is not None for r in self.replans),
                 "seconds": {
                     "median": self.median_replan_seconds,
                     "mean": statistics.fmean(times) if times else None,

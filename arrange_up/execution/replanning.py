@@ -7,17 +7,21 @@ observation (:class:`~arrange_up.execution.belief.ParticleFilter`) and estimates
 plan's success under the posterior with a few rollouts (``check_rollouts`` particles drawn
 from the posterior, each running the rest of the plan under the model's noise, then the goal
 test). When the estimate falls below ``threshold`` it replans from the posterior
-(:func:`arrange_up.planning.planner.plan` with ``start=``) within ``budget`` seconds, and goes
-on with the new plan when one is found (else with the old one). When the plan has run out it
-checks the goal under the posterior (the fraction of particles that satisfy it) and replans
-again if that is below the threshold. The loop ends when the plan has run out and the
-posterior satisfies the goal, after ``max_replans`` replans, ``max_actions`` actions, or the
-first action the executor could not carry out.
+(:func:`arrange_up.planning.planner.plan` with ``start=``) within ``budget`` seconds, scores
+every plan found and the rest of the current plan on the same rollouts from the posterior,
+and goes on with the best (a new plan only when it beats the current one). When the plan has
+run out it checks the goal under the posterior (the fraction of particles that satisfy it)
+and replans again if that is below the threshold. The loop ends when the plan has run out
+and the posterior satisfies the goal, when no plan found beats stopping there, after
+``max_replans`` replans, ``max_actions`` actions, or at the first action the executor could
+not carry out.
 
 The start belief of a replan depends on the semantics: ``particles`` plans from
-``particles`` particles drawn from the posterior; ``deterministic`` from its most central
-particle (the one nearest the posterior's mean: certainty-equivalent replanning);
-``cbst`` from the interval belief fitted over the posterior.
+``particles`` particles drawn from the posterior; ``deterministic`` from each of
+``candidates`` single particles, the most central one (nearest the posterior's mean:
+certainty-equivalent replanning) and others drawn from the posterior, a nominal plan per
+particle, of which the scoring keeps the one most robust under the posterior; ``cbst`` from
+the interval belief fitted over the posterior.
 
 Everything random derives from ``seed`` and the episode number: the filter's propagation and
 resampling, the checks' rollouts, and the replans' seeds.
@@ -58,7 +62,9 @@ class ClosedLoopSettings:
 
     ``filter_particles`` is the belief's size; ``check_rollouts`` the rollouts of one success
     estimate; ``threshold`` the estimate below which it replans; ``semantics``,
-    ``particles``, ``max_nodes`` and ``budget`` (seconds) configure a replan;
+    ``particles``, ``max_nodes`` and ``budget`` (seconds, for all of one replan's searches)
+    configure a replan, ``candidates`` the start particles a ``deterministic`` replan plans
+    from (the most central one, then others drawn from the posterior);
     ``max_replans`` and ``max_actions`` bound an episode; ``gate`` is the filter's
     model-failure gate; ``landing`` the rollouts' rule for a paddle put down on a part.
     """
@@ -69,6 +75,7 @@ class ClosedLoopSettings:
     semantics: str = "particles"
     particles: int = 10
     max_nodes: int = 300
+    candidates: int = 4
     budget: float = 30.0
     max_replans: int = 4
     max_actions: int = 30
@@ -82,31 +89,33 @@ class ClosedLoopSettings:
 @dataclass(frozen=True)
 class Replan:
     """One replan: after ``after`` actions, triggered by the success ``estimate``; the
-    planner's ``status``, its wall-clock ``seconds``, the new plan's length (0 unsolved)."""
+    planner's ``status`` (``solved`` when any start gave a plan), the wall-clock ``seconds``
+    of the whole replan (planning and scoring the candidates), the distinct ``plans`` found,
+    the length of the plan adopted (None: no plan beat the current one, which goes on), and
+    the estimated success of what goes on (``adopted_estimate``)."""
 
     after: int
     estimate: float
     status: str
     seconds: float
-    actions: int
+    plans: int
+    adopted: int | None
+    adopted_estimate: float
 
     def to_json(self) -> dict[str, Any]:
-        return {
-            "after": self.after,
-            "estimate": self.estimate,
-            "status": self.status,
-            "seconds": self.seconds,
-            "actions": self.actions,
-        }
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
     @classmethod
     def from_json(cls, data: dict[str, Any]) -> Replan:
+        adopted = data["adopted"]
         return cls(
             int(data["after"]),
             float(data["estimate"]),
             str(data["status"]),
             float(data["seconds"]),
-            int(data["actions"]),
+            int(data["plans"]),
+            None if adopted is None else int(adopted),
+            float(data["adopted_estimate"]),
         )
 
 
@@ -180,9 +189,11 @@ class ClosedLoop:
                 if len(replans) >= s.max_replans:
                     stopped = "replans exhausted"
                     break
-                found = self._replan(belief, len(executed), estimate, episode, len(replans), rng)
+                found = self._replan(
+                    belief, remaining, len(executed), estimate, episode, len(replans), rng
+                )
                 replans.append(found[0])
-                if found[1] is None:
+                if not found[1]:  # nothing better than stopping here
                     stopped = "no plan"
                     break
                 remaining = list(found[1])
@@ -208,7 +219,7 @@ class ClosedLoop:
                 estimate = self._plan_rate(belief, remaining, rng)
                 if estimate < s.threshold:
                     found = self._replan(
-                        belief, len(executed), estimate, episode, len(replans), rng
+                        belief, remaining, len(executed), estimate, episode, len(replans), rng
                     )
                     replans.append(found[0])
                     if found[1] is not None:
@@ -232,11 +243,14 @@ class ClosedLoop:
         return float(np.mean([not self.goal.misses(state) for state in belief.particles]))
 
     def _plan_rate(
-        self, belief: ParticleBelief, remaining: Sequence[Action], rng: np.random.Generator
+        self, belief: ParticleBelief, actions: Sequence[Action], rng: np.random.Generator
     ) -> float:
-        """The rest of the plan's success rate over ``check_rollouts`` rollouts from particles
-        drawn from ``belief`` (model noise, the rollouts' failures, then the goal test)."""
-        rollouts = Rollouts(self.problem, remaining, landing=self.settings.landing)
+        """The success rate of ``actions`` from ``belief`` over ``check_rollouts`` rollouts from
+        particles drawn from it (model noise, the rollouts' failures, then the goal test); the
+        goal's rate under ``belief`` when ``actions`` is empty."""
+        if not actions:
+            return self._goal_rate(belief)
+        rollouts = Rollouts(self.problem, actions, landing=self.settings.landing)
         particles = belief.particles
         picks = rng.integers(0, len(particles), size=self.settings.check_rollouts)
         good = 0
@@ -246,45 +260,80 @@ class ClosedLoop:
         return good / len(picks)
 
     # -- replanning --------------------------------------------------------------------------
-    def _start(self, belief: ParticleBelief, rng: np.random.Generator) -> Any:
-        """The replan's start belief in its semantics' representation (module docstring)."""
+    def _starts(self, belief: ParticleBelief, rng: np.random.Generator) -> list[Any]:
+        """The replan's start beliefs in its semantics' representation (module docstring)."""
         s = self.settings
         if s.semantics == "cbst":
-            return belief.intervals
+            return [belief.intervals]
         particles = belief.particles
         if s.semantics == "deterministic":
             poses = belief.poses.reshape(len(belief), -1)
             spread = poses.std(axis=0) + 1e-9
             distance = np.sum(((poses - poses.mean(axis=0)) / spread) ** 2, axis=1)
-            return ParticleBelief((particles[int(np.argmin(distance))],))
+            central = int(np.argmin(distance))
+            others = [i for i in range(len(particles)) if i != central]
+            count = min(s.candidates - 1, len(others))
+            drawn = rng.choice(len(others), size=count, replace=False) if count else []
+            chosen = [central, *(others[int(i)] for i in drawn)]
+            return [ParticleBelief((particles[i],)) for i in chosen]
         count = min(s.particles, len(particles))
         chosen = rng.choice(len(particles), size=count, replace=False)
-        return ParticleBelief(tuple(particles[int(i)] for i in sorted(chosen)))
+        return [ParticleBelief(tuple(particles[int(i)] for i in sorted(chosen)))]
 
     def _replan(
         self,
         belief: ParticleBelief,
+        remaining: Sequence[Action],
         after: int,
         estimate: float,
         episode: int,
         number: int,
         rng: np.random.Generator,
     ) -> tuple[Replan, tuple[Action, ...] | None]:
-        """Plan from the posterior within the budget: the record, and the plan (None when
-        the planner found none)."""
+        """Plan from the posterior within the budget, then keep the best plan found if it
+        beats the rest of the current plan: the record, and that plan (None: go on as
+        before). Every candidate and the current plan are scored on the same rollouts
+        (common random numbers), so the comparison is paired."""
         s = self.settings
         started = time.monotonic()
-        seed = int(np.random.default_rng([self.seed, episode, number, 0x2E9]).integers(2**31))
-        result = plan(
-            self.problem,
-            semantics=s.semantics,
-            particles=s.particles,
-            seed=seed,
-            max_nodes=s.max_nodes,
-            timeout=s.budget,
-            start=self._start(belief, rng),
+        plans: list[tuple[Action, ...]] = []
+        status = None
+        for k, start in enumerate(self._starts(belief, rng)):
+            left = s.budget - (time.monotonic() - started)
+            if left <= 0.0:
+                break
+            seed = int(
+                np.random.default_rng([self.seed, episode, number, k, 0x2E9]).integers(2**31)
+            )
+            result = plan(
+                self.problem,
+                semantics=s.semantics,
+                particles=s.particles,
+                seed=seed,
+                max_nodes=s.max_nodes,
+                timeout=left,
+                start=start,
+            )
+            if result.solved:
+                status = "solved"
+                if result.actions not in plans:
+                    plans.append(result.actions or ())
+            elif status is None:
+                status = str(result.status)
+        key = [self.seed, episode, number, 0xE57]
+        best: tuple[Action, ...] | None = None
+        best_rate = self._plan_rate(belief, remaining, np.random.default_rng(key))
+        for candidate in plans:
+            rate = self._plan_rate(belief, candidate, np.random.default_rng(key))
+            if rate > best_rate:
+                best, best_rate = candidate, rate
+        record = Replan(
+            after,
+            estimate,
+            status or "timeout",
+            time.monotonic() - started,
+            len(plans),
+            None if best is None else len(best),
+            best_rate,
         )
-        seconds = time.monotonic() - started
-        actions = result.actions if result.solved else None
-        record = Replan(after, estimate, str(result.status), seconds, len(actions or ()))
-        return record, actions
+        return record, best
