@@ -19,7 +19,7 @@ from arrange_up.cli.shared import (
     seed_option,
 )
 from arrange_up.evaluation.records import RecordFileError, plan_hash
-from arrange_up.execution.episodes import EpisodeRecord, run_episodes
+from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.observations import SENSES
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.model.problem import problem_hash
@@ -105,6 +105,20 @@ _DEFAULTS = ClosedLoopSettings()
     help="Append every episode to this .jsonl file as it finishes; re-running with the same "
     "file resumes the run.",
 )
+@click.option(
+    "--storyboard",
+    type=OutputFile((".png", ".svg", ".pdf")),
+    default=None,
+    help="Also draw episode --storyboard-episode: per action the true world, the observation "
+    "and the posterior (PNG, SVG or PDF).",
+)
+@click.option(
+    "--storyboard-episode",
+    type=click.IntRange(0, None),
+    default=0,
+    show_default=True,
+    help="The episode --storyboard draws (run again, traced: the same episode).",
+)
 @json_option("Print a machine-readable summary (JSON) on stdout.")
 def execute(
     problem: str,
@@ -121,6 +135,8 @@ def execute(
     threshold: float,
     noise_scale: float,
     record: str | None,
+    storyboard: str | None,
+    storyboard_episode: int,
     as_json: bool,
 ) -> None:
     """Execute a plan for PROBLEM closed loop: sense, update the belief, replan.
@@ -138,6 +154,7 @@ def execute(
       arrange-up execute blocks-2 --episodes 5
       arrange-up execute tz-mating --semantics deterministic --sense paddle --episodes 20
       arrange-up execute blocks-4 b4.json --noise-scale 2 --record b4.episodes.jsonl --json
+      arrange-up execute tz-mating --semantics deterministic --storyboard tz-episode.png
 
     Exit status: 0 the episodes ran (whatever the rate), 1 no first plan was found or
     interrupted, 2 bad input.
@@ -187,6 +204,14 @@ def execute(
         fail(f"interrupted{kept}", EXIT_NEGATIVE)
     except (RecordFileError, ValueError) as error:
         fail(str(error))
+    if storyboard is not None:
+        from arrange_up.figures.episode import draw_episode  # matplotlib: only when drawing
+
+        _, outcome, executor = run_episode(
+            loaded, actions, sense, settings, seed, storyboard_episode, scale=noise_scale,
+            trace=True,
+        )  # fmt: skip
+        draw_episode(loaded, executor.trace, outcome, storyboard)
     if as_json:
         summary = result.to_json()
         summary.update(
@@ -194,6 +219,7 @@ def execute(
             problem={"name": loaded.name, "hash": problem_hash(loaded), "source": loaded.source},
             plan={"path": plan_file, "hash": plan_hash(actions), "actions": len(actions)},
             record=record,
+            storyboard=storyboard,
             episode_records=[e.to_json() for e in result.episodes],
         )
         echo_json(summary)
@@ -217,3 +243,5 @@ def execute(
             click.echo(line)
     if record:
         click.echo(f"episodes recorded in {record}")
+    if storyboard:
+        click.echo(f"episode {storyboard_episode} drawn in {storyboard}")

@@ -135,7 +135,8 @@ class StepTrace:
 class LoopOutcome:
     """What one run of the loop did: the actions executed (in order), the replans, the model
     failures, the failure that ended it (an action the executor could not carry out), why it
-    stopped, the final posterior and the goal's estimate under it."""
+    stopped, the final posterior and the goal's estimate under it; with ``trace``, every
+    step (:class:`StepTrace`) and the belief before the first action (``prior``)."""
 
     executed: tuple[Action, ...]
     replans: tuple[Replan, ...]
@@ -145,6 +146,7 @@ class LoopOutcome:
     belief: ParticleBelief
     estimate: float
     trace: tuple[StepTrace, ...] = field(default=(), compare=False)
+    prior: ParticleBelief | None = field(default=None, compare=False)
 
 
 class ClosedLoop:
@@ -173,7 +175,7 @@ class ClosedLoop:
         belief_filter = ParticleFilter(
             self.problem, self.sensor, s.filter_particles, rng, gate=s.gate, landing=s.landing
         )
-        belief = belief_filter.initial()
+        belief = prior = belief_filter.initial()
         remaining = list(self.actions)
         executed: list[Action] = []
         replans: list[Replan] = []
@@ -235,6 +237,7 @@ class ClosedLoop:
             belief,
             self._goal_rate(belief),
             tuple(steps),
+            prior if trace else None,
         )
 
     # -- estimates ---------------------------------------------------------------------------

@@ -218,3 +218,20 @@ def test_the_fake_robot_example_runs_the_loop(capsys):
     runpy.run_path(str(example), run_name="__main__")
     printed = capsys.readouterr().out
     assert "push" in printed and "stopped: " in printed
+
+
+def test_the_storyboard_of_an_episode_draws_observations_and_posteriors(blocks2, tmp_path):
+    from arrange_up.execution import run_episode
+    from arrange_up.figures.episode import draw_episode, episode_data
+
+    problem, actions = blocks2
+    settings = ClosedLoopSettings(filter_particles=6, check_rollouts=2, max_replans=0)
+    _, outcome, executor = run_episode(problem, actions, "paddle", settings, 0, 0, trace=True)
+    data = episode_data(executor.trace, outcome)
+    assert len(data["beliefs"]) == len(outcome.trace) + 1 == len(data["nominal"])
+    assert len(data["rollouts"]) == 6  # one grey trace per posterior particle
+    written = draw_episode(problem, executor.trace, outcome, tmp_path / "episode.png")
+    assert written.stat().st_size > 10_000
+    _, untraced, _ = run_episode(problem, actions, "paddle", settings, 0, 0)
+    with pytest.raises(ValueError, match="not traced"):
+        episode_data(executor.trace, untraced)
