@@ -41,6 +41,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-nodes", type=int, default=300)
     parser.add_argument("--replan-budget", type=float, default=30.0)
     parser.add_argument("--filter-particles", type=int, default=64)
+    parser.add_argument("--landing", default="fail", choices=("fail", "shove"))
     parser.add_argument("--output-dir", type=Path, default=Path("closed-loop-results"))
     args = parser.parse_args(argv)
     out = args.output_dir
@@ -62,11 +63,18 @@ def main(argv: list[str] | None = None) -> int:
             particles=args.particles,
             max_nodes=args.max_nodes,
             budget=args.replan_budget,
+            landing=args.landing,
         )
         tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
+        if args.landing != "fail":
+            tag += f".{args.landing}"
         row = {}
         for mode, sense, settings in (
-            ("open", "none", ClosedLoopSettings(filter_particles=1, max_replans=0)),
+            (
+                "open",
+                "none",
+                ClosedLoopSettings(filter_particles=1, max_replans=0, landing=args.landing),
+            ),
             ("closed", args.sense, closed),
         ):
             label = tag if mode == "open" else f"{tag}.{args.semantics}{args.particles}"
@@ -100,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
             }
         row["plan"] = {"semantics": args.plan_semantics, "actions": len(actions)}
         row["noise_scale"] = args.noise_scale
+        row["landing"] = args.landing
         summary[f"{tag}.{args.semantics}{args.particles}"] = row
         summary_path.write_text(json.dumps(summary, indent=2) + "\n")
         o, c = row["open"], row["closed"]

@@ -19,6 +19,7 @@ from arrange_up.cli.shared import (
     seed_option,
 )
 from arrange_up.evaluation.records import RecordFileError, plan_hash
+from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.observations import SENSES
 from arrange_up.execution.replanning import ClosedLoopSettings
@@ -99,6 +100,14 @@ _DEFAULTS = ClosedLoopSettings()
     help="The simulated world's noise, as a multiple of the problem's modelled noise.",
 )
 @click.option(
+    "--landing",
+    type=click.Choice(LANDINGS),
+    default="fail",
+    show_default=True,
+    help="A push whose paddle is put down onto a part: fail the action, or shove (let the "
+    "physics resolve the overlap and go on), in the world and in the belief alike.",
+)
+@click.option(
     "--record",
     type=OutputFile(),
     default=None,
@@ -134,6 +143,7 @@ def execute(
     filter_particles: int,
     threshold: float,
     noise_scale: float,
+    landing: str,
     record: str | None,
     storyboard: str | None,
     storyboard_episode: int,
@@ -176,6 +186,7 @@ def execute(
         max_nodes=max_nodes,
         budget=replan_budget,
         max_replans=max_replans,
+        landing=landing,
     )
 
     def report(episode: EpisodeRecord) -> None:
@@ -233,9 +244,9 @@ def execute(
     median = result.median_replan_seconds
     timing = "" if median is None else f", median {median:.2f} s per replan"
     click.echo(
-        f"sense {sense}, noise x{noise_scale:g}, seed {seed}: {result.mean_replans:.2f} replans "
-        f"per episode ({len(result.replans)} in all{timing}), {result.model_failures} model "
-        f"failures, {rel.elapsed:.1f} s"
+        f"sense {sense}, noise x{noise_scale:g}, landing {landing}, seed {seed}: "
+        f"{result.mean_replans:.2f} replans per episode ({len(result.replans)} in all{timing}), "
+        f"{result.model_failures} model failures, {rel.elapsed:.1f} s"
     )
     if rel.failures.total:
         click.echo(f"failures: {rel.failures.total}")
