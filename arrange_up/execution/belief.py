@@ -24,7 +24,10 @@ problem's noise ``scale`` times wider (2, then 4;
 :func:`~arrange_up.execution.executor.scaled_problem`) and the objects already on the table
 displaced within ``scale - 1`` times the place uncertainty, and keeps the first of these that
 explains the observation (the failure records the scale); when none does, it keeps the
-widest, weighted all the same (the record says ``recovered: false``).
+widest, weighted all the same (the record says ``recovered: false``). With ``adapt`` (the
+default) the world has shown itself noisier than modelled, so the filter goes on propagating
+with the scale that explained it (:attr:`ParticleFilter.scale`), and the loop checks and
+replans with that scale too.
 
 Interval beliefs (CBST, :func:`intersect_intervals`): a ``poses`` observation bounds each
 object to within ``gate`` standard deviations of what was seen; the belief's box is
@@ -134,6 +137,7 @@ class ParticleFilter:
         gate: float = DEFAULT_GATE,
         recovery: Sequence[float] = RECOVERY_SCALES,
         landing: str = "fail",
+        adapt: bool = True,
     ) -> None:
         if particles < 1:
             raise ValueError(f"a particle filter needs at least one particle, got {particles}")
@@ -144,6 +148,10 @@ class ParticleFilter:
         self.gate = gate
         self.recovery = tuple(recovery)
         self.landing = landing
+        self.adapt = adapt
+        #: The noise scale the filter propagates with: 1 (the problem's model) until a model
+        #: failure was recovered at a wider scale, with ``adapt``, then that scale.
+        self.scale = 1.0
         self.frame = AngleFrame.of(problem)
         self._rollouts = {1.0: Rollouts(problem, (), landing=landing)}
 
@@ -155,12 +163,12 @@ class ParticleFilter:
         self, belief: ParticleBelief, action: Action, index: int, observation: Observation
     ) -> Update:
         """``belief`` after ``action`` (the episode's ``index``-th) and ``observation``."""
-        states, predictions = self._predict(belief.particles, action, index, 1.0)
+        states, predictions = self._predict(belief.particles, action, index, self.scale)
         weights, excess = self._weigh(observation, predictions)
         failure = None
         if excess > self.gate:
             scale = None
-            for factor in self.recovery:
+            for factor in (f for f in self.recovery if f > self.scale):
                 wide_states, wide_predictions = self._predict(
                     self._displaced(belief.particles, factor), action, index, factor
                 )
@@ -171,6 +179,8 @@ class ParticleFilter:
                     scale = factor
                     break
             failure = ModelFailure(index, excess, scale)
+            if scale is not None and self.adapt:
+                self.scale = scale
         if not states:
             # Nothing the model (even widened) predicts survives the action: keep the belief
             # as it was; the failure says so.

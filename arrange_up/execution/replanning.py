@@ -41,7 +41,7 @@ from arrange_up.belief.states import ParticleBelief
 from arrange_up.evaluation.outcomes import Failure
 from arrange_up.evaluation.rollouts import Rollouts
 from arrange_up.execution.belief import DEFAULT_GATE, ModelFailure, ParticleFilter
-from arrange_up.execution.executor import ExecutionFailed, Executor
+from arrange_up.execution.executor import ExecutionFailed, Executor, scaled_problem
 from arrange_up.execution.observations import Observation, Sensor
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
@@ -66,7 +66,9 @@ class ClosedLoopSettings:
     configure a replan, ``candidates`` the start particles a ``deterministic`` replan plans
     from (the most central one, then others drawn from the posterior);
     ``max_replans`` and ``max_actions`` bound an episode; ``gate`` is the filter's
-    model-failure gate; ``landing`` the rollouts' rule for a paddle put down on a part.
+    model-failure gate; ``landing`` the rollouts' rule for a paddle put down on a part;
+    ``adapt``: after a model failure recovered at a wider noise scale, the filter, the
+    checks and the replans use that scale (:class:`~arrange_up.execution.belief.ParticleFilter`).
     """
 
     filter_particles: int = 64
@@ -81,6 +83,7 @@ class ClosedLoopSettings:
     max_actions: int = 30
     gate: float = DEFAULT_GATE
     landing: str = "fail"
+    adapt: bool = True
 
     def to_json(self) -> dict[str, Any]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
@@ -166,14 +169,22 @@ class ClosedLoop:
         self.settings = settings
         self.seed = seed
         self.goal = GoalTest(problem)
+        self._models: dict[float, ArrangementProblem] = {}
+        self._filter: ParticleFilter | None = None  # the running episode's
 
     def run(self, executor: Executor, episode: int = 0, *, trace: bool = False) -> LoopOutcome:
         """Execute the plan on ``executor`` as episode ``episode``; ``trace`` keeps every step's
         beliefs (:attr:`LoopOutcome.trace`)."""
         s = self.settings
         rng = np.random.default_rng([self.seed, episode, 0xC105ED])
-        belief_filter = ParticleFilter(
-            self.problem, self.sensor, s.filter_particles, rng, gate=s.gate, landing=s.landing
+        belief_filter = self._filter = ParticleFilter(
+            self.problem,
+            self.sensor,
+            s.filter_particles,
+            rng,
+            gate=s.gate,
+            landing=s.landing,
+            adapt=s.adapt,
         )
         belief = prior = belief_filter.initial()
         remaining = list(self.actions)
@@ -241,6 +252,14 @@ class ClosedLoop:
         )
 
     # -- estimates ---------------------------------------------------------------------------
+    def _model(self) -> ArrangementProblem:
+        """The problem with the noise scale the filter has adapted to (1: as modelled)."""
+        scale = 1.0 if self._filter is None else self._filter.scale
+        cached = self._models.get(scale)
+        if cached is None:
+            cached = self._models[scale] = scaled_problem(self.problem, scale)
+        return cached
+
     def _goal_rate(self, belief: ParticleBelief) -> float:
         """The fraction of the posterior's particles that satisfy the goal."""
         return float(np.mean([not self.goal.misses(state) for state in belief.particles]))
@@ -253,7 +272,7 @@ class ClosedLoop:
         goal's rate under ``belief`` when ``actions`` is empty."""
         if not actions:
             return self._goal_rate(belief)
-        rollouts = Rollouts(self.problem, actions, landing=self.settings.landing)
+        rollouts = Rollouts(self._model(), actions, landing=self.settings.landing)
         particles = belief.particles
         picks = rng.integers(0, len(particles), size=self.settings.check_rollouts)
         good = 0
@@ -309,7 +328,7 @@ class ClosedLoop:
                 np.random.default_rng([self.seed, episode, number, k, 0x2E9]).integers(2**31)
             )
             result = plan(
-                self.problem,
+                self._model(),
                 semantics=s.semantics,
                 particles=s.particles,
                 seed=seed,

@@ -235,3 +235,19 @@ def test_the_storyboard_of_an_episode_draws_observations_and_posteriors(blocks2,
     _, untraced, _ = run_episode(problem, actions, "paddle", settings, 0, 0)
     with pytest.raises(ValueError, match="not traced"):
         episode_data(executor.trace, untraced)
+
+
+@pytest.mark.parametrize("adapt", [True, False])
+def test_a_placement_outside_the_model_is_recovered_and_adapted_to(blocks2, adapt):
+    problem, actions = blocks2
+    place = actions[0]
+    assert isinstance(place, Place)
+    sensor = sensor_for(problem, "poses")
+    belief_filter = ParticleFilter(problem, sensor, 20, np.random.default_rng(2), adapt=adapt)
+    x, y, theta = place.pose
+    seen = Observation(poses=((place.obj, (x - 0.55, y, theta)),))  # place noise: ±0.2 in
+    update = belief_filter.update(belief_filter.initial(), place, 0, seen)
+    assert update.failure is not None and update.failure.scale == 2.0
+    # the posterior follows the observation, not the model
+    assert update.posterior.poses[:, 0, 0].mean() < x - 0.3
+    assert belief_filter.scale == (2.0 if adapt else 1.0)
