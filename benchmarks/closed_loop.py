@@ -43,11 +43,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--filter-particles", type=int, default=64)
     parser.add_argument("--landing", default="fail", choices=("fail", "shove"))
     parser.add_argument("--output-dir", type=Path, default=Path("closed-loop-results"))
+    parser.add_argument(
+        "--table",
+        action="store_true",
+        help="Print closed_loop.json as a Markdown table, run nothing.",
+    )
     args = parser.parse_args(argv)
     out = args.output_dir
-    out.mkdir(parents=True, exist_ok=True)
     summary_path = out / "closed_loop.json"
-    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    if args.table:
+        print(table(json.loads(summary_path.read_text())))
+        return 0
+    out.mkdir(parents=True, exist_ok=True)
     for name in [p for p in args.problems.split(",") if p]:
         problem = load(name)
         first = plan(
@@ -109,6 +116,8 @@ def main(argv: list[str] | None = None) -> int:
         row["plan"] = {"semantics": args.plan_semantics, "actions": len(actions)}
         row["noise_scale"] = args.noise_scale
         row["landing"] = args.landing
+        # read again before writing: another run may have added its problems meanwhile
+        summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
         summary[f"{tag}.{args.semantics}{args.particles}"] = row
         summary_path.write_text(json.dumps(summary, indent=2) + "\n")
         o, c = row["open"], row["closed"]
@@ -120,6 +129,40 @@ def main(argv: list[str] | None = None) -> int:
             flush=True,
         )
     return 0
+
+
+def _rate(mode: dict) -> str:
+    low, high = mode["interval"]
+    return (
+        f"{mode['successes']}/{mode['trials']} = {100 * mode['rate']:.0f} % "
+        f"({100 * low:.0f}–{100 * high:.0f})"
+    )
+
+
+def table(summary: dict) -> str:
+    """The summaries as a Markdown table: per run, both rates with their 95% Wilson
+    intervals, the closed loop's replans per episode and median seconds per replan, its model
+    failures and its failures by kind."""
+    lines = [
+        "| run | open loop | closed loop | replans / episode | median s / replan "
+        "| model failures | closed-loop failures (goal / action / rest / off) |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for key, row in summary.items():
+        closed = row["closed"]
+        seconds = closed["replans"]["seconds"]["median"]
+        f = closed["failures"]
+        kinds = (
+            f"{f['goal_missed']['rollouts']} / {f['action_failed']['rollouts']} / "
+            f"{f['not_at_rest']['rollouts']} / {f['off_table']['rollouts']}"
+        )
+        lines.append(
+            f"| {key} | {_rate(row['open'])} | {_rate(closed)} | "
+            f"{closed['replans']['per_episode']:.2f} | "
+            f"{'—' if seconds is None else f'{seconds:.2f}'} | "
+            f"{closed['model_failures']['total']} | {kinds} |"
+        )
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
