@@ -38,7 +38,7 @@ from arrange_up.model.world import WorldState
 
 __all__ = ["draw_episode"]
 
-OBSERVED_COLOR = "#d73027"
+OBSERVED_COLOR = "#e7298a"  # magenta: no part colour
 
 
 def episode_data(
