@@ -232,7 +232,12 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
         handle.close()
         raise RecordFileError(f"{path}: the record file is in use by another run")
     handle.seek(0)
-    lines = [line for line in handle.read().split(b"\n") if line.strip()]
+    data = handle.read()
+    if data and not data.endswith(b"\n"):
+        # the last line was cut off (a run killed while writing): drop it, run it again
+        data = data[: data.rfind(b"\n") + 1]
+        handle.truncate(len(data))
+    lines = [line for line in data.split(b"\n") if line.strip()]
     episodes: dict[int, EpisodeRecord] = {}
     if not lines:
         handle.truncate(0)
@@ -253,8 +258,6 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
         try:
             record = EpisodeRecord.from_json(json.loads(line))
         except (ValueError, KeyError, TypeError) as error:
-            if number == len(lines):  # a last line cut off by a killed run: run it again
-                continue
             handle.close()
             raise RecordFileError(f"{path}:{number}: not an episode record: {error}") from None
         episodes[record.episode] = record

@@ -70,6 +70,8 @@ def test_the_sensor_draws_its_documented_noise_and_folds_symmetric_angles(blocks
     delta, _ = sensor.residuals(turned, [Observation(poses=state.poses)])
     assert np.abs(delta).max() < 1e-9
     assert sensor_for(problem, "none").predict(actions[0], outcome) == Observation()
+    both = Observation(paddle=(1.0, 2.0, 0.5), poses=(("A", (3.0, 3.0, 0.1)),))
+    assert Observation.from_json(json.loads(json.dumps(both.to_json()))) == both
 
 
 def test_a_paddle_observation_narrows_the_belief_to_the_particles_that_explain_it(blocks2):
@@ -156,6 +158,11 @@ def test_episodes_resume_from_their_record(blocks2, tmp_path):
     for line in lines[1:]:
         data = json.loads(line)
         assert EpisodeRecord.from_json(data).to_json() == data
+    # a line cut off by a killed run is dropped and its episode run again
+    record.write_text(record.read_text() + lines[-1][:20])
+    cut = run_episodes(problem, actions, episodes=3, seed=1, settings=settings, record=record)
+    assert cut.resumed == 3 and cut.episodes == again.episodes
+    assert record.read_text().count("\n") == 4
     other = ClosedLoopSettings(filter_particles=9)
     with pytest.raises(ValueError, match="another closed-loop run"):
         run_episodes(problem, actions, episodes=1, seed=1, settings=other, record=record)
