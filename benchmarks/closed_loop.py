@@ -18,10 +18,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import statistics
 import sys
 from pathlib import Path
 
-from arrange_up.execution.episodes import run_episodes
+from arrange_up.evaluation.reliability import wilson_interval
+from arrange_up.execution.episodes import EpisodeRecord, run_episodes
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.io.domains import load
 from arrange_up.planning.planner import plan
@@ -52,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     out = args.output_dir
     summary_path = out / "closed_loop.json"
     if args.table:
-        print(table(json.loads(summary_path.read_text())))
+        print(table(out))
         return 0
     out.mkdir(parents=True, exist_ok=True)
     for name in [p for p in args.problems.split(",") if p]:
@@ -131,36 +133,62 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _rate(mode: dict) -> str:
-    low, high = mode["interval"]
-    return (
-        f"{mode['successes']}/{mode['trials']} = {100 * mode['rate']:.0f} % "
-        f"({100 * low:.0f}–{100 * high:.0f})"
-    )
+def _read(path: Path) -> tuple[dict, dict[int, EpisodeRecord]]:
+    """A record file's header and its episodes by number."""
+    lines = [line for line in path.read_text().splitlines() if line.strip()]
+    episodes = {}
+    for line in lines[1:]:
+        record = EpisodeRecord.from_json(json.loads(line))
+        episodes[record.episode] = record
+    return json.loads(lines[0]), episodes
 
 
-def table(summary: dict) -> str:
-    """The summaries as a Markdown table: per run, both rates with their 95% Wilson
-    intervals, the closed loop's replans per episode and median seconds per replan, its model
-    failures and its failures by kind."""
+def _rate(records: list[EpisodeRecord]) -> str:
+    good = sum(r.success for r in records)
+    low, high = wilson_interval(good, len(records))
+    rate = 100 * good / len(records)
+    return f"{good}/{len(records)} = {rate:.0f} % ({100 * low:.0f}–{100 * high:.0f})"
+
+
+def table(out: Path) -> str:
+    """Every closed-loop record in ``out`` beside its open-loop partner, on the episodes both
+    hold (paired), as a Markdown table: both rates with their 95% Wilson intervals, the
+    closed loop's replans per episode, median seconds per replan, model failures, failures by
+    kind, and the replanning settings its header records."""
     lines = [
         "| run | open loop | closed loop | replans / episode | median s / replan "
-        "| model failures | closed-loop failures (goal / action / rest / off) |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| model failures | closed-loop failures (goal / action / rest / off) | replanning |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    for key, row in summary.items():
-        closed = row["closed"]
-        seconds = closed["replans"]["seconds"]["median"]
-        f = closed["failures"]
-        kinds = (
-            f"{f['goal_missed']['rollouts']} / {f['action_failed']['rollouts']} / "
-            f"{f['not_at_rest']['rollouts']} / {f['off_table']['rollouts']}"
+    for path in sorted(out.glob("*.closed.jsonl")):
+        label = path.name.removesuffix(".closed.jsonl")
+        partner = out / f"{label.rsplit('.', 1)[0]}.open.jsonl"
+        if not partner.exists():
+            continue
+        header, closed = _read(path)
+        _, opened = _read(partner)
+        common = sorted(set(closed) & set(opened))
+        if not common:
+            continue
+        c = [closed[i] for i in common]
+        times = [r.seconds for e in c for r in e.replans]
+        median = f"{statistics.median(times):.2f}" if times else "—"
+        kinds = [str(e.failure.kind) for e in c if e.failure is not None]
+        counts = " / ".join(
+            str(kinds.count(k))
+            for k in ("goal_missed", "action_failed", "not_at_rest", "off_table")
         )
+        s = header["settings"]
+        if s["semantics"] == "deterministic":
+            how = f"deterministic from {s.get('candidates', 1)} particles"
+        else:
+            how = f"{s['semantics']}, {s['particles']} particles"
+        how += f", {s['max_nodes']} nodes, {s['budget']:g} s"
+        how += "" if s.get("adapt") else ", no adapt"
         lines.append(
-            f"| {key} | {_rate(row['open'])} | {_rate(closed)} | "
-            f"{closed['replans']['per_episode']:.2f} | "
-            f"{'—' if seconds is None else f'{seconds:.2f}'} | "
-            f"{closed['model_failures']['total']} | {kinds} |"
+            f"| {label} | {_rate([opened[i] for i in common])} | {_rate(c)} | "
+            f"{statistics.fmean(len(e.replans) for e in c):.2f} | {median} | "
+            f"{sum(len(e.model_failures) for e in c)} | {counts} | {how} |"
         )
     return "\n".join(lines)
 
