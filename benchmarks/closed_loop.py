@@ -44,6 +44,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--replan-budget", type=float, default=30.0)
     parser.add_argument("--filter-particles", type=int, default=64)
     parser.add_argument("--landing", default="fail", choices=("fail", "shove"))
+    parser.add_argument(
+        "--no-adapt",
+        action="store_true",
+        help="Keep the modelled noise after a model failure (ClosedLoopSettings.adapt off).",
+    )
     parser.add_argument("--output-dir", type=Path, default=Path("closed-loop-results"))
     parser.add_argument(
         "--table",
@@ -73,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
             max_nodes=args.max_nodes,
             budget=args.replan_budget,
             landing=args.landing,
+            adapt=not args.no_adapt,
         )
         tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
         if args.landing != "fail":
