@@ -26,6 +26,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("transitions",),
     ("planning",),
     ("evaluation",),
+    ("execution",),
     ("repair",),
     ("up",),
     ("figures",),

@@ -2,10 +2,11 @@
 
 One module per command group (:mod:`~arrange_up.cli.problems`: domains, check, export;
 :mod:`~arrange_up.cli.show`; :mod:`~arrange_up.cli.plan`; :mod:`~arrange_up.cli.evaluate`;
-:mod:`~arrange_up.cli.repair`; :mod:`~arrange_up.cli.train`; :mod:`~arrange_up.cli.experiments`;
-:mod:`~arrange_up.cli.bench`), and :mod:`~arrange_up.cli.shared` for what they share. Each
-command parses its arguments, calls one library function, renders the result and sets the exit
-status (0 success, 1 a negative answer, 2 bad input; see :mod:`~arrange_up.cli.shared`).
+:mod:`~arrange_up.cli.execute`; :mod:`~arrange_up.cli.repair`; :mod:`~arrange_up.cli.train`;
+:mod:`~arrange_up.cli.experiments`; :mod:`~arrange_up.cli.bench`), and
+:mod:`~arrange_up.cli.shared` for what they share. Each command parses its arguments, calls
+one library function, renders the result and sets the exit status (0 success, 1 a negative
+answer, 2 bad input; see :mod:`~arrange_up.cli.shared`).
 
 This module holds only the top-level group, :func:`main`.
 """
@@ -46,6 +47,11 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
         "evaluate",
         "evaluate",
         "Estimate how reliably PLAN.json achieves PROBLEM's goal, by noisy rollouts.",
+    ),
+    "execute": (
+        "execute",
+        "execute",
+        "Execute a plan for PROBLEM closed loop: sense, update the belief, replan.",
     ),
     "experiment": (
         "experiments",

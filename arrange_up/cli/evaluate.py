@@ -37,7 +37,11 @@ from arrange_up.parallel import BackendUnavailableError
 
 
 def _describe_action(actions: Sequence[Action], index: int) -> str:
-    """``action 3 (push paddle)``: 1-based, as in the plan table of ``arrange-up plan``."""
+    """``action 3 (push paddle)``: 1-based, as in the plan table of ``arrange-up plan``;
+    ``action 9`` alone past the end of ``actions`` (a closed-loop episode's replanned
+    actions)."""
+    if index >= len(actions):
+        return f"action {index + 1}"
     action = actions[index]
     kind = type(action).__name__.lower()
     who = action.manipulator if isinstance(action, Push) else action.obj

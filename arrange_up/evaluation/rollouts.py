@@ -54,7 +54,12 @@ from arrange_up.geometry.collision import PenetrationDepths
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Place, WorldState, draw_noise
 from arrange_up.physics import simulation  # simulate looked up per call: tests replace it
-from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus
+from arrange_up.physics.simulation import (
+    DEFAULT_SETTINGS,
+    PhysicsSettings,
+    StepOutcome,
+    StepStatus,
+)
 
 __all__ = [
     "LANDINGS",
@@ -62,6 +67,7 @@ __all__ = [
     "Execution",
     "RolloutContext",
     "Rollouts",
+    "Step",
     "check_landing",
     "execute_plan",
     "rollout_task",
@@ -101,6 +107,17 @@ class Execution:
         return self.failure is None
 
 
+@dataclass(frozen=True)
+class Step:
+    """One action executed: the state reached (the state before the action when the action
+    could not be applied), the physics' outcome (``None`` when the physics refused the call)
+    and the failure, ``None`` when the action went through."""
+
+    state: WorldState
+    outcome: StepOutcome | None
+    failure: Failure | None
+
+
 class Rollouts:
     """The rollouts of one plan on one problem: what they need, built once (goal test, angle
     frame, penetration depths), and the loop that runs them."""
@@ -134,17 +151,22 @@ class Rollouts:
         state, failure = self._execute(state, rng, states)
         if failure is not None:
             return RolloutRecord(index, False, failure)
+        failure = self.goal_failure(state)
+        return RolloutRecord(index, failure is None, failure)
+
+    def goal_failure(self, state: WorldState) -> Failure | None:
+        """The ``goal_missed`` failure of a final ``state`` (which parts miss, in which
+        dimensions, by how much), or None when it satisfies the goal."""
         misses = self.goal.misses(state)
-        if misses:
-            failure = Failure(
-                GOAL_MISSED,
-                misses=tuple(
-                    GoalMiss(m.part, m.dimensions(), tuple(float(e) for e in m.excess))  # type: ignore[arg-type]
-                    for m in misses
-                ),
-            )
-            return RolloutRecord(index, False, failure)
-        return RolloutRecord(index, True)
+        if not misses:
+            return None
+        return Failure(
+            GOAL_MISSED,
+            misses=tuple(
+                GoalMiss(m.part, m.dimensions(), tuple(float(e) for e in m.excess))  # type: ignore[arg-type]
+                for m in misses
+            ),
+        )
 
     def execute(self, state: WorldState, rng: np.random.Generator) -> Execution:
         """The plan's actions from ``state``, each one's noise drawn from ``rng`` just before it
@@ -157,37 +179,56 @@ class Rollouts:
         self, state: WorldState, rng: np.random.Generator, states: list[WorldState]
     ) -> tuple[WorldState, Failure | None]:
         """The one loop: ``(last state, failure or None)``, each state reached appended."""
+        for k, action in enumerate(self.actions):
+            step = self.step(k, action, state, rng)
+            state = step.state
+            if step.failure is not None:
+                return state, step.failure
+            states.append(state)
+        return state, None
+
+    def step(self, k: int, action: Action, state: WorldState, rng: np.random.Generator) -> Step:
+        """Action ``k`` of a plan executed from ``state``: its noise drawn from ``rng``, then
+        simulated and judged as every rollout judges it (the failures of the module
+        docstring). Closed-loop execution (:mod:`arrange_up.execution`) runs its actions one at
+        a time through here."""
         problem = self.problem
         tolerance = self.settings.overlap_tolerance
-        for k, action in enumerate(self.actions):
-            noise = draw_noise(problem, action, rng)
-            try:
-                outcome = simulation.simulate(problem, state, action, noise, self.push_settings)
-            except ValueError as error:
-                return state, Failure(ACTION_FAILED, k, str(error))
-            if outcome.status is StepStatus.OVERLAP:
-                return state, Failure(
+        noise = draw_noise(problem, action, rng)
+        try:
+            outcome = simulation.simulate(problem, state, action, noise, self.push_settings)
+        except ValueError as error:
+            return Step(state, None, Failure(ACTION_FAILED, k, str(error)))
+        if outcome.status is StepStatus.OVERLAP:
+            return Step(
+                state,
+                outcome,
+                Failure(
                     ACTION_FAILED,
                     k,
                     f"{PUSH_OVERLAP_REASON} (by more than {tolerance:g} in)",
                     f"deepest overlap {outcome.overlap:.4f} in",
-                )
-            if outcome.status is StepStatus.NOT_AT_REST:
-                return state, Failure(NOT_AT_REST, k)
-            if outcome.status is StepStatus.OFF_TABLE:
-                return state, Failure(OFF_TABLE, k, objects=tuple(outcome.off_table))
-            state = outcome.state
-            if isinstance(action, Place):
-                other, depth = self.depths.deepest(state, action.obj)
-                if depth > tolerance:
-                    return state, Failure(
+                ),
+            )
+        if outcome.status is StepStatus.NOT_AT_REST:
+            return Step(state, outcome, Failure(NOT_AT_REST, k))
+        if outcome.status is StepStatus.OFF_TABLE:
+            return Step(state, outcome, Failure(OFF_TABLE, k, objects=tuple(outcome.off_table)))
+        state = outcome.state
+        if isinstance(action, Place):
+            other, depth = self.depths.deepest(state, action.obj)
+            if depth > tolerance:
+                return Step(
+                    state,
+                    outcome,
+                    Failure(
                         ACTION_FAILED,
                         k,
                         f"placed overlapping {other} (by more than {tolerance:g} in)",
                         f"overlap {depth:.4f} in",
-                    )
-            states.append(state)
-        return state, None
+                    ),
+                )
+        return Step(state, outcome, None)
 
 
 def execute_plan(

@@ -249,7 +249,9 @@ class StepOutcome:
     ``NOT_AT_REST``, ``OFF_TABLE``, ``OK``. ``sim_time`` and ``steps`` count the simulated time
     and physics steps (0 for place and pick); ``manipulator_travel`` is how far the paddle moved
     along its push direction while it was driven (in); ``overlap`` the deepest overlap between
-    shapes when the push started (in, 0 when none).
+    shapes when the push started (in, 0 when none). ``manipulator_pose`` is the paddle's pose
+    when the push ended, just before it is lifted off (what a robot's joint encoders report
+    after the push; ``None`` for place and pick).
     """
 
     state: WorldState
@@ -259,6 +261,7 @@ class StepOutcome:
     steps: int = 0
     manipulator_travel: float = 0.0
     overlap: float = 0.0
+    manipulator_pose: Pose | None = None
 
     @property
     def ok(self) -> bool:
@@ -626,6 +629,8 @@ def _push(
         for (obj, _), b in zip(state.poses, movable, strict=True):
             pos = get_pos(b)
             poses.append((obj, (pos.x, pos.y, get_angle(b))))
+        pos = get_pos(paddle)
+        paddle_pose = (pos.x, pos.y, get_angle(paddle))
     finally:
         lib.cpSpaceFree(space)
         for shape in shapes:
@@ -649,6 +654,7 @@ def _push(
         steps=steps,
         manipulator_travel=travel,
         overlap=overlap,
+        manipulator_pose=paddle_pose,
     )
 
 

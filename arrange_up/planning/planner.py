@@ -200,6 +200,7 @@ def plan(
     progress: ProgressCallback | None = None,
     should_stop: Callable[[], bool] | None = None,
     model: str | Path | None = None,
+    start: Any = None,
 ) -> PlanResult:
     """Search for a conformant plan for ``problem``.
 
@@ -252,6 +253,12 @@ def plan(
         The learned model of a semantics that has one (``cbst``: a shipped name or the card
         of a model ``arrange-up train-cbst`` made); ``None``: the shipped default. A model for
         another semantics, or one that does not load, raises ``ValueError``.
+    start
+        The belief to plan from instead of the problem's initial belief, in the semantics'
+        representation: a :class:`~arrange_up.belief.states.ParticleBelief` for ``particles``
+        and ``deterministic`` (any particle count; one particle plans for that state alone), an
+        :class:`~arrange_up.belief.states.IntervalBelief` for ``cbst``. Closed-loop execution
+        replans from its posterior this way (:mod:`arrange_up.execution.replanning`).
     """
     started = time.monotonic()
     limit = (
@@ -267,6 +274,7 @@ def plan(
         dominance=dominance,
         variety=variety,
         model=model,
+        start=start,
     )
 
     def report(stats: SearchStats) -> None:

@@ -53,6 +53,10 @@ class BeliefTask:
     variety_seed
         None: successors are the generator's candidates as proposed. An integer: every push is
         offered whole or cut short, drawn from this seed (see :func:`vary_push`).
+    start
+        None: the search starts from the semantics' initial belief (the problem's initial
+        uncertainty). Otherwise the belief it starts from, in the semantics' representation
+        (replanning from a posterior, :mod:`arrange_up.execution`).
     """
 
     semantics: Semantics
@@ -61,6 +65,7 @@ class BeliefTask:
     heuristic: Callable[[Any], float]
     dominance: bool
     variety_seed: int | None
+    start: Any = None
 
     @classmethod
     def build(
@@ -75,6 +80,7 @@ class BeliefTask:
         dominance: bool,
         variety: bool,
         model: str | Path | None = None,
+        start: Any = None,
     ) -> BeliefTask:
         """The task of :func:`~arrange_up.planning.planner.plan`'s arguments of the same names.
 
@@ -97,11 +103,12 @@ class BeliefTask:
         except BaseException:
             model.close()
             raise
-        return cls(model, goal, generator, estimate, dominance, seed if variety else None)
+        return cls(model, goal, generator, estimate, dominance, seed if variety else None, start)
 
     def initial_belief(self) -> Any:
-        """The belief the search starts from."""
-        return self.semantics.initial_belief()
+        """The belief the search starts from: :attr:`start` when given, else the semantics'
+        initial belief."""
+        return self.semantics.initial_belief() if self.start is None else self.start
 
     def is_goal(self, belief: Any) -> bool:
         """True iff every particle of ``belief`` satisfies the goal."""

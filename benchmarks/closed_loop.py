@@ -1,0 +1,203 @@
+"""Closed loop against open loop, on the same simulated worlds (issue 16's targets).
+
+    python benchmarks/closed_loop.py --problems tz-mating --episodes 20
+    python benchmarks/closed_loop.py --problems blocks-4 --noise-scale 2 --plan-semantics particles
+    python benchmarks/closed_loop.py --problems tz-mating,create-a-t --episodes 200 --output-dir out
+
+For each problem: a first plan (``--plan-semantics``: ``deterministic`` gives the nominal plan,
+the open-loop comparator of the mating problems; ``particles`` a particle plan), then the same
+episodes (episode i's world drawn from (seed, i), noise ``--noise-scale`` times the model's)
+run twice: open loop (the plan executed as it is: no replans, no sensing) and closed loop
+(``--sense``, replanning with ``--semantics`` / ``--particles`` / ``--max-nodes`` /
+``--replan-budget``). The two rates are therefore paired. Every episode is appended to a
+``.jsonl`` record per problem and mode in ``--output-dir`` (re-running resumes), and the summary
+of each pair to ``closed_loop.json`` there (merged with the problems already in it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+from pathlib import Path
+
+from arrange_up.evaluation.reliability import wilson_interval
+from arrange_up.execution.episodes import EpisodeRecord, run_episodes
+from arrange_up.execution.replanning import ClosedLoopSettings
+from arrange_up.io.domains import load
+from arrange_up.planning.planner import plan
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--problems", default="tz-mating")
+    parser.add_argument("--episodes", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--sense", default="paddle")
+    parser.add_argument("--noise-scale", type=float, default=1.0)
+    parser.add_argument("--plan-semantics", default="deterministic")
+    parser.add_argument("--plan-particles", type=int, default=10)
+    parser.add_argument("--semantics", default="deterministic")
+    parser.add_argument("--particles", type=int, default=10)
+    parser.add_argument("--max-nodes", type=int, default=300)
+    parser.add_argument("--replan-budget", type=float, default=30.0)
+    parser.add_argument("--filter-particles", type=int, default=64)
+    parser.add_argument("--landing", default="fail", choices=("fail", "shove"))
+    parser.add_argument(
+        "--no-adapt",
+        action="store_true",
+        help="Keep the modelled noise after a model failure (ClosedLoopSettings.adapt off).",
+    )
+    parser.add_argument("--output-dir", type=Path, default=Path("closed-loop-results"))
+    parser.add_argument(
+        "--table",
+        action="store_true",
+        help="Print closed_loop.json as a Markdown table, run nothing.",
+    )
+    args = parser.parse_args(argv)
+    out = args.output_dir
+    summary_path = out / "closed_loop.json"
+    if args.table:
+        print(table(out))
+        return 0
+    out.mkdir(parents=True, exist_ok=True)
+    for name in [p for p in args.problems.split(",") if p]:
+        problem = load(name)
+        first = plan(
+            problem, semantics=args.plan_semantics, particles=args.plan_particles, seed=args.seed
+        )
+        if not first.solved:
+            print(f"{name}: no first plan ({first.reason})", flush=True)
+            continue
+        actions = first.actions or ()
+        closed = ClosedLoopSettings(
+            filter_particles=args.filter_particles,
+            semantics=args.semantics,
+            particles=args.particles,
+            max_nodes=args.max_nodes,
+            budget=args.replan_budget,
+            landing=args.landing,
+            adapt=not args.no_adapt,
+        )
+        tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
+        if args.landing != "fail":
+            tag += f".{args.landing}"
+        row = {}
+        for mode, sense, settings in (
+            (
+                "open",
+                "none",
+                ClosedLoopSettings(filter_particles=1, max_replans=0, landing=args.landing),
+            ),
+            ("closed", args.sense, closed),
+        ):
+            label = tag if mode == "open" else f"{tag}.{args.semantics}{args.particles}"
+            result = run_episodes(
+                problem,
+                actions,
+                sense=sense,
+                episodes=args.episodes,
+                seed=args.seed,
+                scale=args.noise_scale,
+                settings=settings,
+                record=out / f"{label}.{mode}.jsonl",
+                progress=lambda e, mode=mode, name=name: print(
+                    f"{name} {mode} episode {e.episode}: {'ok' if e.success else e.failure.kind}"
+                    f" ({len(e.replans)} replans)",
+                    flush=True,
+                ),
+            )
+            data = result.to_json()
+            row[mode] = {
+                "successes": data["successes"],
+                "trials": data["trials"],
+                "rate": data["rate"],
+                "interval": data["interval"],
+                "replans": data["replans"],
+                "model_failures": data["model_failures"],
+                "stopped": data["stopped"],
+                "failures": data["failures"],
+                "settings": data["settings"],
+                "sense": sense,
+            }
+        row["plan"] = {"semantics": args.plan_semantics, "actions": len(actions)}
+        row["noise_scale"] = args.noise_scale
+        row["landing"] = args.landing
+        # read again before writing: another run may have added its problems meanwhile
+        summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+        summary[f"{tag}.{args.semantics}{args.particles}"] = row
+        summary_path.write_text(json.dumps(summary, indent=2) + "\n")
+        o, c = row["open"], row["closed"]
+        print(
+            f"{name}: open loop {o['successes']}/{o['trials']} ({100 * o['rate']:.1f}%), "
+            f"closed loop {c['successes']}/{c['trials']} ({100 * c['rate']:.1f}%, "
+            f"{c['replans']['per_episode']:.2f} replans per episode, median "
+            f"{c['replans']['seconds']['median']} s per replan)",
+            flush=True,
+        )
+    return 0
+
+
+def _read(path: Path) -> tuple[dict, dict[int, EpisodeRecord]]:
+    """A record file's header and its episodes by number."""
+    lines = [line for line in path.read_text().splitlines() if line.strip()]
+    episodes = {}
+    for line in lines[1:]:
+        record = EpisodeRecord.from_json(json.loads(line))
+        episodes[record.episode] = record
+    return json.loads(lines[0]), episodes
+
+
+def _rate(records: list[EpisodeRecord]) -> str:
+    good = sum(r.success for r in records)
+    low, high = wilson_interval(good, len(records))
+    rate = 100 * good / len(records)
+    return f"{good}/{len(records)} = {rate:.0f} % ({100 * low:.0f}–{100 * high:.0f})"
+
+
+def table(out: Path) -> str:
+    """Every closed-loop record in ``out`` beside its open-loop partner, on the episodes both
+    hold (paired), as a Markdown table: both rates with their 95% Wilson intervals, the
+    closed loop's replans per episode, median seconds per replan, model failures, failures by
+    kind, and the replanning settings its header records."""
+    lines = [
+        "| run | open loop | closed loop | replans / episode | median s / replan "
+        "| model failures | closed-loop failures (goal / action / rest / off) | replanning |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for path in sorted(out.glob("*.closed.jsonl")):
+        label = path.name.removesuffix(".closed.jsonl")
+        partner = out / f"{label.rsplit('.', 1)[0]}.open.jsonl"
+        if not partner.exists():
+            continue
+        header, closed = _read(path)
+        _, opened = _read(partner)
+        common = sorted(set(closed) & set(opened))
+        if not common:
+            continue
+        c = [closed[i] for i in common]
+        times = [r.seconds for e in c for r in e.replans]
+        median = f"{statistics.median(times):.2f}" if times else "—"
+        kinds = [str(e.failure.kind) for e in c if e.failure is not None]
+        counts = " / ".join(
+            str(kinds.count(k))
+            for k in ("goal_missed", "action_failed", "not_at_rest", "off_table")
+        )
+        s = header["settings"]
+        if s["semantics"] == "deterministic":
+            how = f"deterministic from {s.get('candidates', 1)} particles"
+        else:
+            how = f"{s['semantics']}, {s['particles']} particles"
+        how += f", {s['max_nodes']} nodes, {s['budget']:g} s"
+        how += "" if s.get("adapt") else ", no adapt"
+        lines.append(
+            f"| {label} | {_rate([opened[i] for i in common])} | {_rate(c)} | "
+            f"{statistics.fmean(len(e.replans) for e in c):.2f} | {median} | "
+            f"{sum(len(e.model_failures) for e in c)} | {counts} | {how} |"
+        )
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
