@@ -8,6 +8,8 @@ outcomes compare and hash equal and the search dedupes them.
 * **initial belief**: the problem's initial poses and uncertainties.
 * **place**: the object's box is the commanded pose ± the place uncertainty.
 * **pick**: the object is removed.
+* **place of a fixture**: no prediction (:data:`FIXTURE_REFUSAL`); the planner's fences
+  (:mod:`arrange_up.planning.fences`) are for the simulated semantics.
 * **push**: the belief is mapped into the canonical "push toward +u" frame
   (:class:`~arrange_up.cbst.frame.CanonicalFrame`), the contact graph decides what moves
   (:func:`~arrange_up.cbst.contact_graph.analyse_push`), and every object of the compressed
@@ -59,6 +61,13 @@ from arrange_up.model.world import Action, Pick, Place, Push
 
 __all__ = ["CBSTSemantics"]
 
+#: Why a fixture's place has no prediction: the learned model composes a train from a table
+#: wall back to the paddle, and a fence stands where its training had no wall (a fixture at an
+#: uncertain pose, with an end the train may slip past).
+FIXTURE_REFUSAL = (
+    "CBST cannot predict pushes against a placed fixture: its model was trained against table "
+    "walls only"
+)
 #: Shapes and sizes are compared with this tolerance (inches).
 _SIZE_TOL = 1e-6
 
@@ -155,6 +164,8 @@ class CBSTSemantics:
             return self._push(belief, action)
         objects = dict(belief.objects)
         if isinstance(action, Place):
+            if self.problem.object(action.obj).kind is ObjectKind.FIXTURE:
+                return self._refuse(FIXTURE_REFUSAL)
             objects[action.obj] = self._interval(
                 action.obj, action.pose, self.problem.uncertainty.place
             )

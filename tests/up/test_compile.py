@@ -87,8 +87,10 @@ def test_relative_goal_fluents_and_wrapped_initial_angles():
     assert values["theta(Z)"] == 90
     assert (values["rel_x(Z)"], values["rel_y(Z)"], values["rel_theta(Z)"]) == (5, -4, 90)
     assert all(isinstance(v, Fraction | bool) for v in values.values())
-    # on_table of the reference and of the part, two bounds on each relative coordinate
-    assert len(up.goals) == 2 + 6
+    # on_table of the reference and of the part, two bounds on each relative coordinate,
+    # and the bar fixture, which starts off the table, off it again
+    assert len(up.goals) == 2 + 6 + 1
+    assert str(up.goals[-1]) == "(not on_table(bar))"
     assert "(80 <= rel_theta(Z))" in {str(g) for g in up.goals}
 
 
