@@ -60,8 +60,16 @@ are as before.
 A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
 such a push cannot help it, and it multiplies the search's plateaus.
 
-**Pick**: fixtures and manipulators on the table may be picked up; parts are never picked by
-the planner (a part must end on the table).
+**Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
+tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
+against there), places of a fixture at the part's goal face, after the places of parts; a push
+to a fence on the table, as to a wall; and along that axis no push that ends in the open (to
+the goal coordinate, or narrowing) while a fence stands there or can be put down. Nothing of
+this is offered for a problem whose parts need no fence (every shipped problem).
+
+**Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
+part at its goal while the part still misses its goal along the other axis; parts are never
+picked by the planner (a part must end on the table).
 
 Preconditions are tested on belief shadows (:mod:`arrange_up.geometry.collision`): a placed object's
 shadow (target ± place uncertainty) and a manipulator's approach shadow (approach pose ± push

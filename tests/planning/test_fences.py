@@ -4,6 +4,8 @@ picks up again; problems that do not need one are planned as before."""
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from pathlib import Path
 
 import pytest
@@ -15,6 +17,7 @@ from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.io.yaml_problem import load_problem
+from arrange_up.model.problem import Uncertainty
 from arrange_up.model.world import Pick, Place, Push, WorldState
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.transitions import make_semantics
@@ -106,10 +109,31 @@ def test_the_planner_builds_its_own_fence_and_its_plan_reaches_the_goal_in_rollo
     assert reliability.successes >= FLOORS[semantics], reliability.failures
 
 
-def test_cbst_refuses_a_fixture_place_with_its_reason(corner):
-    semantics = make_semantics("cbst", corner)
-    belief = semantics.initial_belief()
-    assert semantics.apply(belief, Place("bar", (6.65, 1.304473, 0.0))) is None
+def test_cbst_takes_a_fence_for_the_wall_ahead_and_refuses_one_the_block_may_slip_past(corner):
+    # CBST's training domain needs the thesis's +-0.05 in push noise
+    problem = dataclasses.replace(
+        corner,
+        uncertainty=Uncertainty(
+            place=(0.03, 0.03, math.radians(2)), push=(0.05, 0.05, math.radians(3))
+        ),
+    )
+    semantics = make_semantics("cbst", problem)
+    gen = ActionGenerator(
+        problem, CollisionChecker(problem), unclipped_pushes=True, settled_wall_pushes=True
+    )
+    block = ("A", ObjectInterval((4.0, 0.55, 0.0), (0.05, 0.05, 0.02)))
+    bar = ("bar", ObjectInterval((6.65, 1.304473, 0.0), (0.03, 0.03, math.radians(2))))
+    belief = IntervalBelief((block, bar))
+    (push,) = [p for p in gen.pushes(belief) if abs(p.pose[2] + math.pi / 2) < 1e-3]
+    after = semantics.apply(belief, push).get("A")
+    # pressed against the bar's face (x = 6.5): A's centre at 6 within the face's own spread
+    # (0.03 in of place, 2 degrees over the bar's 2.5 in) and the model's dx and slop
+    assert after.center[0] - after.half[0] < 6.0 < after.center[0] + after.half[0]
+    assert after.half[0] < 0.15
+    # the bar moved up: A's centre lies below its end, so A may slip past it
+    high = ("bar", ObjectInterval((6.65, 2.3, 0.0), bar[1].half))
+    longer = Push(push.manipulator, push.pose, push.distance + 0.1)
+    assert semantics.apply(IntervalBelief((block, high)), longer) is None
     assert semantics.reasons[FIXTURE_REFUSAL] == 1
 
 
