@@ -2,13 +2,15 @@
 
 Usage::
 
-    python benchmarks/fresh_problems.py [--particles 20] [--timeout 300] [--rollouts 200]
-        [--problems tests/problems/fresh/*.yaml] [--output fresh.csv]
+    python benchmarks/fresh_problems.py [--particles 20] [--semantics particles]
+        [--timeout 300] [--rollouts 200] [--problems tests/problems/fresh/*.yaml]
+        [--output fresh.csv]
 
 For each problem file (default: every file of ``tests/problems/fresh/``, written for issue 13's
 kinds: a narrowing squeeze, a detour round a post, a relative pair whose reference must move,
 an open-table goal that needs a fixture, an L part into a corner, a 5-block T, a column of four,
-a tight row), plans as ``arrange-up plan FILE --particles N`` does (seed 0, one worker), then
+a tight row; and two open tables that need the planner's own fence), plans as ``arrange-up
+plan FILE --particles N --semantics S`` does (seed 0, one worker), then
 evaluates a found plan with ``--rollouts`` noisy rollouts (seed 0) and prints a row: status,
 nodes expanded, planning seconds, plan length, successes, and the planner's reason when no plan
 was found. Each row is appended to the CSV (if given) as soon as it is measured.
@@ -29,6 +31,7 @@ FRESH = Path(__file__).resolve().parents[1] / "tests" / "problems" / "fresh"
 FIELDS = [
     "problem",
     "controller",
+    "semantics",
     "particles",
     "status",
     "expanded",
@@ -40,15 +43,20 @@ FIELDS = [
 ]
 
 
-def measure(path: Path, particles: int, timeout: float, rollouts: int) -> dict[str, object]:
+def measure(
+    path: Path, particles: int, timeout: float, rollouts: int, semantics: str = "particles"
+) -> dict[str, object]:
     problem = load_problem(path)
     started = time.perf_counter()
-    result = plan(problem, particles=particles, seed=0, workers=1, timeout=timeout)
+    result = plan(
+        problem, semantics=semantics, particles=particles, seed=0, workers=1, timeout=timeout
+    )
     seconds = time.perf_counter() - started
     row: dict[str, object] = {
         "problem": problem.name,
         "controller": problem.controller.kind.value,
-        "particles": particles,
+        "semantics": result.semantics,
+        "particles": result.particles,
         "status": str(result.status),
         "expanded": result.stats["expanded"],
         "seconds": round(seconds, 1),
@@ -67,6 +75,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problems", nargs="*", type=Path, default=None)
     parser.add_argument("--particles", type=int, default=20)
+    parser.add_argument("--semantics", default="particles", help="deterministic, particles, ...")
     parser.add_argument("--timeout", type=float, default=300.0, help="planning seconds")
     parser.add_argument("--rollouts", type=int, default=200)
     parser.add_argument("--output", type=Path, default=None)
@@ -82,7 +91,7 @@ def main() -> None:
             writer.writeheader()
     try:
         for path in paths:
-            row = measure(path, args.particles, args.timeout, args.rollouts)
+            row = measure(path, args.particles, args.timeout, args.rollouts, args.semantics)
             print(" ".join(f"{k}={row[k]}" for k in FIELDS if row[k] != ""), flush=True)
             if writer is not None and handle is not None:
                 writer.writerow(row)

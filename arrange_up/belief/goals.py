@@ -7,6 +7,10 @@ A world state satisfies an absolute goal when every goal part is on the table wi
 applied to each part's pose expressed in the reference part's frame. A particle belief
 satisfies the goal when every particle does (§1.2.2).
 
+A fixture that starts off the table must be off it again at the end: a fence the planner puts
+down is picked up before the goal counts as reached (the plans of the fixture repair always
+were; a fixture that starts on the table may stay).
+
 Everything is vectorised over particles: goal tests run in the search's inner loop, where going
 through unified-planning expressions would cost ~100x more.
 """
@@ -30,15 +34,19 @@ EPS = 1e-9
 @dataclass(frozen=True)
 class PartMiss:
     """How one part misses its goal in one state: per-dimension excess beyond the tolerance
-    (0 where within), or ``missing`` when the part is not on the table."""
+    (0 where within), or ``missing`` when the part is not on the table; for a fixture that
+    started off the table, ``left`` when it is still on it (``part`` then names the fixture)."""
 
     part: str
     missing: bool
     excess: tuple[float, float, float]
+    left: bool = False
 
     def dimensions(self) -> tuple[str, ...]:
         if self.missing:
             return ("off table",)
+        if self.left:
+            return ("on table",)
         return tuple(d for d, e in zip(("x", "y", "theta"), self.excess, strict=True) if e > 0)
 
 
@@ -55,6 +63,10 @@ class GoalTest:
         self.tolerance = np.array([tol[0], tol[1], math.inf if tol[2] is None else tol[2]])
         self.periods = np.array(
             [symmetry_period(problem.object(p).shape) for p in self.parts], dtype=float
+        )
+        #: Fixtures that start off the table, and so must end off it (module docstring).
+        self.put_away: frozenset[str] = frozenset(
+            spec.name for spec in problem.fixtures if problem.initial_of(spec.name) is None
         )
 
     # -- coordinates ---------------------------------------------------------------------------
@@ -97,6 +109,8 @@ class GoalTest:
     # -- tests -----------------------------------------------------------------------------
     def satisfied_array(self, poses: np.ndarray, names: Sequence[str]) -> bool:
         """True if every particle of ``poses`` (``(P, n, 3)``) satisfies the goal."""
+        if self.put_away and not self.put_away.isdisjoint(names):
+            return False
         excess = self.excess(poses, names)
         return excess is not None and not bool(np.any(excess > 0.0))
 
@@ -118,7 +132,12 @@ class GoalTest:
         excess = self.excess(poses, names)
         assert excess is not None
         worst = excess.max(axis=0)
-        return tuple(
+        left = tuple(
+            PartMiss(name, False, (0.0, 0.0, 0.0), left=True)
+            for name in names
+            if name in self.put_away
+        )
+        return left + tuple(
             PartMiss(part, False, tuple(float(v) for v in worst[i]))  # type: ignore[arg-type]
             for i, part in enumerate(self.parts)
             if np.any(worst[i] > 0.0)

@@ -84,7 +84,7 @@ def _dig(data: Any, path: tuple[str, ...]) -> Any:
     return data
 
 
-_DIMENSIONS = frozenset(("x", "y", "theta", "off table"))
+_DIMENSIONS = frozenset(("x", "y", "theta", "off table", "on table"))
 
 
 def _record_problem(data: Any, actions: Any) -> str | None:

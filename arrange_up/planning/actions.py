@@ -60,8 +60,16 @@ are as before.
 A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
 such a push cannot help it, and it multiplies the search's plateaus.
 
-**Pick**: fixtures and manipulators on the table may be picked up; parts are never picked by
-the planner (a part must end on the table).
+**Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
+tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
+against there), places of a fixture at the part's goal face, after the places of parts; a push
+to a fence on the table, as to a wall; and along that axis no push that ends in the open (to
+the goal coordinate, or narrowing) while a fence stands there or can be put down. Nothing of
+this is offered for a problem whose parts need no fence (every shipped problem).
+
+**Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
+part at its goal while the part still misses its goal along the other axis; parts are never
+picked by the planner (a part must end on the table).
 
 Preconditions are tested on belief shadows (:mod:`arrange_up.geometry.collision`): a placed object's
 shadow (target ± place uncertainty) and a manipulator's approach shadow (approach pose ± push
@@ -85,7 +93,10 @@ from arrange_up.model.problem import (
     Pose,
 )
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
+from arrange_up.planning.fences import Fences
 
+#: The wall each push direction heads for.
+_WALL_AHEAD = {"+x": "right", "-x": "left", "+y": "top", "-y": "bottom"}
 #: Direction name -> unit vector in the world frame.
 DIRECTIONS: dict[str, tuple[float, float]] = {
     "+x": (1.0, 0.0),
@@ -145,6 +156,13 @@ class ActionGenerator:
         self.stall_per_area = _stall_per_area(problem)
         self.areas = {spec.name: spec.shape.area for spec in problem.parts}
         self.wall_trains = self._wall_trains()
+        walls = set(problem.table.walls)
+        held = {
+            (part, 0 if DIRECTIONS[direction][0] else 1): True
+            for (part, direction), train in self.wall_trains.items()
+            if train is not None and _WALL_AHEAD[direction] in walls
+        }
+        self.fences = Fences(problem, checker, held)
         self.offsets = {
             spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
             for spec in problem.parts
@@ -199,9 +217,19 @@ class ActionGenerator:
     # -- all candidates --------------------------------------------------------------------
     def candidates(self, belief: IntervalBelief) -> list[Action]:
         """Every applicable candidate action of ``belief`` (preconditions hold), in a fixed
-        order: places, then pushes, then picks."""
+        order: places of parts, places of fences (:mod:`arrange_up.planning.fences`), then
+        pushes, then picks."""
         places = self.places(belief)
-        return [*places, *self.pushes(belief, places), *self.picks(belief)]
+        routes = self.fence_routes(belief)
+        fences = list(dict.fromkeys(a for options in routes.values() for a in options))
+        return [*places, *fences, *self.pushes(belief, places, routes), *self.picks(belief)]
+
+    def fence_routes(self, belief: IntervalBelief) -> dict[tuple[str, int, int], list[Place]]:
+        """The fence places of ``belief``, keyed by the ``(part, axis, sign)`` of the push
+        that would press the part against them (empty unless a goal part needs a fence)."""
+        if not self.fences.needs:
+            return {}
+        return self.fences.placements(belief, self._shadows(belief))
 
     # -- place -----------------------------------------------------------------------------
     def place_target(self, name: str, belief: IntervalBelief) -> Pose | None:
@@ -268,10 +296,17 @@ class ActionGenerator:
         )
 
     # -- push ------------------------------------------------------------------------------
-    def pushes(self, belief: IntervalBelief, places: list[Place] | None = None) -> list[Push]:
-        """The push candidates of ``belief``; ``places``, its place candidates if the caller
-        has them already (:meth:`candidates`), saves computing them again."""
+    def pushes(
+        self,
+        belief: IntervalBelief,
+        places: list[Place] | None = None,
+        routes: dict[tuple[str, int, int], list[Place]] | None = None,
+    ) -> list[Push]:
+        """The push candidates of ``belief``; ``places`` and ``routes``, its place candidates
+        and fence routes if the caller has them already (:meth:`candidates`), save computing
+        them again."""
         on_table = self._shadows(belief)
+        routes = self.fence_routes(belief) if routes is None else routes
         # The ladder for parts without a goal position only when a goal part cannot be placed:
         # otherwise the goal-directed actions make progress, and the ladder only widens the
         # search (relative matings expanded 13 times the nodes with it always on).
@@ -292,13 +327,13 @@ class ActionGenerator:
                 for direction in self.directions:
                     actions.extend(
                         self._pushes_of(
-                            manip, spec.name, interval, direction, belief, on_table, ladder
+                            manip, spec.name, interval, direction, belief, on_table, ladder, routes
                         )
                     )
         return actions
 
     def _pushes_of(
-        self, manip, name, interval, direction, belief, on_table, ladder=False
+        self, manip, name, interval, direction, belief, on_table, ladder=False, routes=None
     ) -> list[Push]:
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
@@ -317,7 +352,9 @@ class ActionGenerator:
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
-        distances = self._distances(name, interval, belief, axis, sign, front_nominal, ladder)
+        distances = self._distances(
+            name, interval, belief, axis, sign, front_nominal, ladder, routes or {}
+        )
         pushes = []
         for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
             pose = (along, across, theta) if axis == 0 else (across, along, theta)
@@ -407,7 +444,7 @@ class ActionGenerator:
         return low, high
 
     def _distances(
-        self, name, interval, belief, axis, sign, front, ladder=False
+        self, name, interval, belief, axis, sign, front, ladder=False, routes=None
     ) -> list[tuple[float, float | None]]:
         """Candidate travel distances of the manipulator (see the module docstring), each with
         the travel of the part it is meant for (``None`` for a push to the wall)."""
@@ -431,16 +468,35 @@ class ActionGenerator:
         ):
             boundary = size if sign > 0 else 0.0
             candidates.append(sign * boundary - front)
+        # A fence (a fixture on the table at the part's goal face) is pushed against as the
+        # wall is; where a fence is needed and one is there or can be put down, the pushes
+        # that end in the open along this axis are not offered: by the problem's own noise
+        # they cannot stop the part within its tolerance (planning.fences).
         target = self.place_target(name, belief)
+        fenced = False
+        if self.fences.needs and name in self.fences.goal_boxes:
+            face = self.fences.face_ahead(name, interval, belief, axis, sign)
+            if face is not None and not (
+                self.compliant
+                and not self.settled_wall_pushes
+                and target is not None
+                and self._inside_goal(interval, target, axis)
+            ):
+                candidates.append(sign * face - front)
+            fenced = self.fences.needed(name, axis) and (
+                face is not None or (name, axis, sign) in (routes or {})
+            )
         stall = self._stall(name, belief, axis, sign) if self.stall_per_area else 0.0
-        travels: dict[float, float | None] = {candidates[0]: None} if candidates else {}
+        travels: dict[float, float | None] = dict.fromkeys(candidates)
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
         # a narrowing push, to the contact of the rearmost state.
         least: dict[float, float] = {}
         if target is not None:
             travel = sign * (target[axis] - interval.center[axis])
             half = interval.half[axis]
-            if travel > MIN_PUSH:
+            if fenced:
+                pass  # the fence's push (above) replaces those that end in the open
+            elif travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
             elif not self._inside_goal(interval, target, axis) and travel + half > MIN_PUSH:
                 # Narrowing: the centre is (about) on target but the spread misses the goal.
@@ -543,8 +599,29 @@ class ActionGenerator:
 
     # -- pick ------------------------------------------------------------------------------
     def picks(self, belief: IntervalBelief) -> list[Pick]:
+        """Picks of the fixtures and manipulators on the table, except a fence that holds a
+        goal part at its goal while that part still has pushes to come
+        (:meth:`~arrange_up.planning.fences.Fences.holding`)."""
         kinds = (ObjectKind.FIXTURE, ObjectKind.MANIPULATOR)
-        return [Pick(name) for name in belief.names() if self.problem.object(name).kind in kinds]
+        keep = self.fences.holding(belief, self._part_inside(belief)) if self.fences.needs else ()
+        return [
+            Pick(name)
+            for name in belief.names()
+            if self.problem.object(name).kind in kinds and name not in keep
+        ]
+
+    def _part_inside(self, belief: IntervalBelief):
+        """``inside(part, axis)``: whether ``part`` lies within its goal along ``axis``."""
+
+        def inside(part: str, axis: int) -> bool:
+            target, interval = self.place_target(part, belief), belief.get(part)
+            return (
+                target is not None
+                and interval is not None
+                and self._inside_goal(interval, target, axis)
+            )
+
+        return inside
 
     # -- helpers ---------------------------------------------------------------------------
     def _shadows(self, belief: IntervalBelief):

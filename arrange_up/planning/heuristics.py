@@ -18,11 +18,15 @@ particle beliefs (§3.1): an interval is inside the goal interval iff every part
   open candidates, walls in every open candidate of the other by the same rule: the cells of a
   corner pocket, which must be filled from the walls outwards); else 0.
 * ``admissible``: ``ordering`` plus one per goal part not yet on the table (each needs at least
-  one place action). Still admissible, and a little better informed than the bare filter.
+  one place action) and one per fixture on the table that must be put away (each needs a pick:
+  :mod:`arrange_up.belief.goals`). Still admissible, and a little better informed than the bare
+  filter.
 * ``inadmissible``: §3.2's per-dimension count: per goal part 2 if it is off the table, 2 if
   neither its x nor its y interval lies within the goal interval, 1 if exactly one does, else 0
   — plus 1 when x and y do but the angle interval does not (our goals also constrain the
-  angle) — combined with the ordering filter. Beliefs with equal counts are ordered by a
+  angle) — plus 1 per fixture on the table that must be put away (a fence the planner put down:
+  it costs a pick, and without the count a search would put down fences in every combination
+  before using one), combined with the ordering filter. Beliefs with equal counts are ordered by a
   fraction below one that grows with their Manhattan distance (a tie-breaker: it never
   outweighs a unit of the count).
 
@@ -80,7 +84,8 @@ def make_heuristic(
     def admissible(belief: ParticleBelief) -> float:
         if ordering.violated(belief):
             return math.inf
-        return float(sum(1 for p in goal.parts if p not in belief.names()))
+        names = belief.names()
+        return float(sum(1 for p in goal.parts if p not in names) + _left(goal, names))
 
     # The count is coarse: many beliefs share a value. A fraction below one, growing with
     # the Manhattan distance, orders beliefs of equal count by how far their parts still are
@@ -107,7 +112,7 @@ def per_dimension_count(goal: GoalTest, belief: ParticleBelief) -> float:
     present = [p in names for p in goal.parts]
     if goal.reference is not None and goal.reference not in names:
         present = [False] * len(goal.parts)
-    total = 2.0 * sum(1 for ok in present if not ok)
+    total = 2.0 * sum(1 for ok in present if not ok) + _left(goal, names)
     if not any(present):
         return total
     coords = _coords_partial(goal, belief, present)
@@ -123,6 +128,11 @@ def per_dimension_count(goal: GoalTest, belief: ParticleBelief) -> float:
         if x_in and y_in and not theta_in:
             total += 1
     return total
+
+
+def _left(goal: GoalTest, names) -> int:
+    """The fixtures among ``names`` that must be off the table at the end (one pick each)."""
+    return sum(1 for name in names if name in goal.put_away) if goal.put_away else 0
 
 
 def _coords(goal: GoalTest, belief: ParticleBelief) -> np.ndarray | None:

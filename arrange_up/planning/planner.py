@@ -156,6 +156,8 @@ class PlanResult:
             missed = ", ".join(
                 f"{m.part} (not on the table)"
                 if m.missing
+                else f"{m.part} (left on the table)"
+                if m.left
                 else f"{m.part} in {' and '.join(m.dimensions())}"
                 for m in self.misses
             )

@@ -19,11 +19,12 @@ from typing import Any
 
 import numpy as np
 
-from arrange_up.belief.states import IntervalBelief, ParticleBelief, symmetry_period
+from arrange_up.belief.states import IntervalBelief, ParticleBelief
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
+from arrange_up.planning.fences import fixture_angles
 
 #: Push distance multipliers (thesis §4.1.2, "Pushing multipliers").
 MULTIPLIERS: tuple[float, ...] = (1.0, 1.25, 1.5, 1.75, 2.0)
@@ -218,9 +219,7 @@ def grid_placements(
     for spec in problem.fixtures:
         if spec.name in on_table:
             continue
-        period = symmetry_period(spec.shape)
-        angles = sorted({round(a % period, 9) for a in (0.0, 0.5 * math.pi)})
-        for theta in angles:
+        for theta in fixture_angles(problem, spec.name):
             for y in ys:
                 for x in xs:
                     pose = (x, y, theta)

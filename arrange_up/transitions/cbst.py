@@ -8,6 +8,15 @@ outcomes compare and hash equal and the search dedupes them.
 * **initial belief**: the problem's initial poses and uncertainties.
 * **place**: the object's box is the commanded pose ± the place uncertainty.
 * **pick**: the object is removed.
+* **a fixture as a wall**: the nearest fixture on the table ahead of the paddle, across its
+  sweep, stands in for the wall ahead (a fence the planner put down:
+  :mod:`arrange_up.planning.fences`) when its nominal footprint spans the centre of every
+  block of the compressed train across the push, with a quarter block to spare on either side
+  (else no prediction, :data:`FIXTURE_REFUSAL`). Its face is as
+  uncertain as its place: the train is composed from the nominal face, and every predicted
+  ``u`` range is widened on both sides by how far the face's shadow reaches beyond the nominal
+  face (the fixture's place noise and turn). The model was trained against rigid table walls;
+  a clamped fixture is one (the physics holds it still), at an uncertain pose.
 * **push**: the belief is mapped into the canonical "push toward +u" frame
   (:class:`~arrange_up.cbst.frame.CanonicalFrame`), the contact graph decides what moves
   (:func:`~arrange_up.cbst.contact_graph.analyse_push`), and every object of the compressed
@@ -59,6 +68,8 @@ from arrange_up.model.world import Action, Pick, Place, Push
 
 __all__ = ["CBSTSemantics"]
 
+#: Why a push towards a fixture has no prediction when the fixture cannot stand in for a wall.
+FIXTURE_REFUSAL = "a pushed object may slip past the end of a fixture ahead"
 #: Shapes and sizes are compared with this tolerance (inches).
 _SIZE_TOL = 1e-6
 
@@ -206,7 +217,24 @@ class CBSTSemantics:
         table = frame.table_box(problem.table.size)
         wall = table[2] if frame.wall_ahead in problem.table.walls else None
         obstacles = [frame.box_to(box) for box in self.checker.obstacle_boxes.values()]
+        fence = self._fence_ahead(belief, frame, paddle, wall)
+        spread = 0.0
+        if fence is not None:
+            name, face, spread = fence
+            wall = face
+            nodes = [node for node in nodes if node.name != name]
         structure = analyse_push(paddle, nodes, wall=wall, block_size=d, obstacles=obstacles)
+        if fence is not None and structure.kind == "predict":
+            fixture = dict(belief.objects)[fence[0]]
+            box = frame.box_to(self.checker.shadow_box(fence[0], fixture.center, (0.0, 0.0, 0.0)))
+            # each member's centre, with a quarter block to spare on either side, in front of
+            # the fixture (the planner's fences cover as much: planning.fences.COVER)
+            by = {node.name: node for node in nodes}
+            if any(
+                by[m.name].center[1] - 0.25 * d < box[1] or by[m.name].center[1] + 0.25 * d > box[3]
+                for m in structure.members
+            ):
+                return self._refuse(FIXTURE_REFUSAL)
         if structure.kind == "unchanged":
             return belief
         if structure.kind == "none":
@@ -252,7 +280,9 @@ class CBSTSemantics:
                 # may be nudged forward up to x_max (plus slop) and sideways by the overlap.
                 x_max = wall - (member.depth - 0.5) * d
                 u_low = cur.center[0] - cur.half[0]
-                u_high = max(cur.center[0] + cur.half[0], x_max + self.allowance(member.depth))
+                u_high = max(
+                    cur.center[0] + cur.half[0], x_max + spread + self.allowance(member.depth)
+                )
                 v_low = max(cur.center[1] - cur.half[1] - member.graze, v_min)
                 v_high = min(cur.center[1] + cur.half[1] + member.graze, v_max)
                 canonical = (0.5 * (u_low + u_high), 0.5 * (v_low + v_high), cur.center[2])
@@ -265,7 +295,8 @@ class CBSTSemantics:
             if slip > BUCKLE_LIMIT:
                 return self._refuse("the model predicts that the train may buckle")
             x_max = wall - (member.depth - 0.5) * d
-            u_low, u_high = x_max - dx, x_max + max(slip, self.allowance(member.depth))
+            u_low = x_max - spread - dx
+            u_high = x_max + spread + max(slip, self.allowance(member.depth))
             v = cur.center[1]
             v_low, v_high = max(v - dy, v_min), min(v + dy, v_max)
             if v_low > v_high:
@@ -276,6 +307,26 @@ class CBSTSemantics:
             )
             objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
         return self._belief(objects)
+
+    def _fence_ahead(self, belief, frame, paddle, wall) -> tuple[str, float, float] | None:
+        """The fixture on the table that stands in for the wall ahead (module docstring):
+        ``(name, nominal face, face spread)`` in the canonical frame, or None."""
+        best = None
+        reach = paddle.reach_box
+        for spec in self.problem.fixtures:
+            interval = belief.get(spec.name)
+            if interval is None:
+                continue
+            nominal = frame.box_to(self.checker.shadow_box(spec.name, interval.center, (0.0,) * 3))
+            shadow = frame.box_to(
+                self.checker.shadow_box(spec.name, interval.center, interval.half)
+            )
+            ahead = shadow[0] >= paddle.box[2] - 1e-9
+            across = min(shadow[3], reach[3]) > max(shadow[1], reach[1])
+            nearer = wall is None or nominal[0] < wall
+            if ahead and across and nearer and (best is None or nominal[0] < best[1]):
+                best = (spec.name, nominal[0], nominal[0] - shadow[0])
+        return best
 
     def close(self) -> None:
         """Nothing to release."""

@@ -19,7 +19,9 @@
 * **Goals**, one condition each: ``on_table(p)`` and ``target - tol <= f(p) <= target + tol``
   for ``f`` in ``x``, ``y``, ``theta`` of each goal part (no ``theta`` condition when the
   tolerance allows any angle). A relative goal constrains ``rel_x``, ``rel_y``, ``rel_theta``
-  instead, and needs ``on_table`` of the reference too.
+  instead, and needs ``on_table`` of the reference too. A fixture that starts off the table
+  must end off it (``not on_table(f)``), as the planner's goal test says
+  (:mod:`arrange_up.belief.goals`).
 
 **Units.** The UP model uses **inches and degrees**, like the ``.pddl`` files, whatever the
 problem file used: numbers a user reads in a UP plan are the numbers they would write. All
@@ -254,6 +256,9 @@ def _goal_conditions(problem: ArrangementProblem, fl: PoseFluents, em: Any) -> l
         for fluent, target, tol in bounds:
             out.append(em.GE(fluent, em.Real(target - tol)))
             out.append(em.LE(fluent, em.Real(target + tol)))
+    for spec in problem.fixtures:
+        if problem.initial_of(spec.name) is None:
+            out.append(em.Not(fl.on_table[spec.name]))
     return out
 
 

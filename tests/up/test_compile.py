@@ -6,6 +6,7 @@ import dataclasses
 import math
 import warnings
 from fractions import Fraction
+from pathlib import Path
 
 import pytest
 from unified_planning.engines.plan_validator import SequentialPlanValidator
@@ -13,7 +14,9 @@ from unified_planning.engines.results import ValidationResultStatus
 from unified_planning.engines.sequential_simulator import UPSequentialSimulator
 from unified_planning.plans import ActionInstance, SequentialPlan
 
+import arrange_up
 from arrange_up.io.domains import load
+from arrange_up.io.yaml_problem import load_problem
 from arrange_up.model.problem import Goal, ObjectKind, ObjectSpec, problem_hash
 from arrange_up.model.world import Pick, Place, Push
 from arrange_up.up.compile import (
@@ -87,8 +90,10 @@ def test_relative_goal_fluents_and_wrapped_initial_angles():
     assert values["theta(Z)"] == 90
     assert (values["rel_x(Z)"], values["rel_y(Z)"], values["rel_theta(Z)"]) == (5, -4, 90)
     assert all(isinstance(v, Fraction | bool) for v in values.values())
-    # on_table of the reference and of the part, two bounds on each relative coordinate
-    assert len(up.goals) == 2 + 6
+    # on_table of the reference and of the part, two bounds on each relative coordinate,
+    # and the bar fixture, which starts off the table, off it again
+    assert len(up.goals) == 2 + 6 + 1
+    assert str(up.goals[-1]) == "(not on_table(bar))"
     assert "(80 <= rel_theta(Z))" in {str(g) for g in up.goals}
 
 
@@ -122,6 +127,19 @@ def test_a_push_that_fails_makes_the_plan_invalid():
     result = SequentialPlanValidator().validate(up, plan)
     assert result.status is ValidationResultStatus.INVALID
     assert "fails under the 'deterministic' semantics" in result.log_messages[0].message
+
+
+def test_a_fence_the_plan_puts_down_must_be_picked_up_for_the_up_goal():
+    fresh = Path(__file__).parents[1] / "problems" / "fresh" / "fence-corner.yaml"
+    problem = load_problem(fresh)
+    result = arrange_up.plan(problem, semantics="deterministic")
+    assert result.solved and result.actions[-1] == Pick("bar")
+    up = to_up(problem)
+    assert "(not on_table(bar))" in {str(g) for g in up.goals}
+    whole = SequentialPlanValidator().validate(up, plan_to_up(up, result.actions))
+    assert whole.status is ValidationResultStatus.VALID
+    left = SequentialPlanValidator().validate(up, plan_to_up(up, result.actions[:-1]))
+    assert left.status is ValidationResultStatus.INVALID
 
 
 def test_exact_numbers_are_decimal_fractions():

@@ -1,0 +1,258 @@
+"""Fences: fixtures the planner puts down for a goal part to be pushed against where the table
+has no wall (thesis §4.2.3 and §5.2's future work: construction and improvement combined).
+
+**When a fence is needed.** A push that ends in the open stops its part no more precisely than
+the push itself: the manipulator's approach lands within ``push`` uncertainty along the push,
+and under the compliant controller the stall (``mu g rho A / Kp``) varies with the friction
+and part density drawn for the action. A part pressed against something fixed ends where that
+thing is. So along an axis of an absolute goal, a goal part *needs a fence* when
+
+* the free push's end spread, ``push[axis] + (stall_max - stall_min) / 2``, exceeds the goal
+  tolerance along the axis;
+* the goal does not hold the part against a wall of the table along that axis (that wall
+  would do the job: :meth:`ActionGenerator._wall_trains`);
+* a fixture pressed against would do better than the tolerance: its own place spread,
+  ``place[axis]`` plus the shift of its face over half the part's width for a place turned by
+  ``place[theta]``, is below the tolerance.
+
+Only problems with fixtures and an absolute goal can need one, and no shipped problem does
+(their plans are unchanged).
+
+**Where a fence goes** (:meth:`Fences.placements`): from the goal, each fixture off the table,
+at each of its distinct right-angle turns (:func:`fixture_angles`, the repair's grid angles),
+with its near face flush with the goal footprint's face on the side the part is pushed
+towards, so that the part pressed against it ends at its target. Across the push it is centred
+on the goal's coordinate and on the part's present one (its swath: where a push along the axis
+moves it) when they differ, each moved as little as keeps the fixture's place shadow on the
+table (``GAP`` from its edges and walls) while its footprint still covers the part's centre
+with ``COVER`` of the part's width to spare on either side; and at either end of that range
+(where it clears another fence: two fences make a corner). The place precondition is the
+planner's (the fixture's place shadow on the table, touching no shadow, wall or obstacle).
+Offered only for a part that needs the fence, is not already within its goal along the axis,
+and would not be pushed away from its goal (the push rule of :mod:`arrange_up.planning.actions`).
+
+**Using it** (:meth:`Fences.face_ahead`): any fixture on the table whose near face lies
+within the tolerance of the part's goal face, ahead of the part's shadow, and whose nominal
+footprint covers the part's centre across the push (as above), is offered as the wall is: a
+push to the face (the compliant controller's set point then lies beyond it, and the force clip
+presses the part against it).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from arrange_up.belief.states import IntervalBelief, symmetry_period
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.model.problem import STANDARD_GRAVITY, ArrangementProblem, ControllerKind, Pose
+from arrange_up.model.world import Place
+
+_ZERO = (0.0, 0.0, 0.0)
+#: A fence must cover the part's centre across the push with this fraction of the part's width
+#: to spare on either side (half the face pressed against it, at least).
+COVER = 0.25
+#: Gap kept between a fence's place shadow and the table's edges (inches), as the manipulator's
+#: approach keeps from what it passes.
+GAP = 0.02
+
+
+def _round(value: float) -> float:
+    """A generated coordinate rounded to 1e-6 in (never ``-0.0``), as the generator's are."""
+    return round(float(value), 6) + 0.0
+
+
+def fixture_angles(problem: ArrangementProblem, name: str) -> list[float]:
+    """The distinct right-angle turns (0 and 90 degrees, fewer for a fixture that looks the
+    same turned) at which fixture ``name`` is placed: by the repair's grid and by fences."""
+    period = symmetry_period(problem.object(name).shape)
+    return sorted({round(a % period, 9) for a in (0.0, 0.5 * math.pi)})
+
+
+def stall_spread(problem: ArrangementProblem) -> float:
+    """Half the range of the compliant controller's stall per square inch of part moved, over
+    the problem's friction and part-density ranges (0 under the servo)."""
+    controller = problem.controller
+    if controller.kind is not ControllerKind.COMPLIANT:
+        return 0.0
+    u = problem.uncertainty
+    low = u.friction[0] * u.part_density[0]
+    high = u.friction[1] * u.part_density[1]
+    return 0.5 * (high - low) * STANDARD_GRAVITY / controller.kp
+
+
+class Fences:
+    """Which goal parts need a fence along which axis, where fences go and which fixture on the
+    table holds a part at its goal (see the module docstring).
+
+    ``held_by_wall`` says for a part and an axis whether the goal holds the part against a wall
+    the table has (the generator's wall trains decide that)."""
+
+    def __init__(
+        self,
+        problem: ArrangementProblem,
+        checker: CollisionChecker,
+        held_by_wall: dict[tuple[str, int], bool],
+    ) -> None:
+        self.problem = problem
+        self.checker = checker
+        self.place_unc = problem.uncertainty.place
+        goal = problem.goal
+        self.goal_boxes: dict[str, tuple[float, ...]] = {}
+        #: (part, axis) -> the free push's end spread, for the axes that need a fence.
+        self.needs: dict[tuple[str, int], float] = {}
+        if goal.is_relative or not problem.fixtures:
+            return
+        spread = stall_spread(problem)
+        push = problem.uncertainty.push
+        for part in goal.parts:
+            box = checker.shadow_box(part, goal.target(part), _ZERO)
+            self.goal_boxes[part] = box
+            area = problem.object(part).shape.area
+            for axis in (0, 1):
+                other = 1 - axis
+                free = push[axis] + spread * area
+                width = box[other + 2] - box[other]
+                fence = self.place_unc[axis] + 0.5 * width * math.sin(self.place_unc[2])
+                tolerance = goal.tolerance[axis]
+                if free > tolerance > fence and not held_by_wall.get((part, axis), False):
+                    self.needs[(part, axis)] = free
+
+    def needed(self, part: str, axis: int) -> bool:
+        return (part, axis) in self.needs
+
+    def goal_face(self, part: str, axis: int, sign: int) -> float:
+        """The coordinate of ``part``'s goal footprint's face on the ``sign`` side along
+        ``axis``."""
+        box = self.goal_boxes[part]
+        return box[axis + 2] if sign > 0 else box[axis]
+
+    # -- where fences go -----------------------------------------------------------------------
+    def placements(
+        self,
+        belief: IntervalBelief,
+        on_table: Sequence[tuple[str, Pose, tuple[float, float, float]]],
+    ) -> dict[tuple[str, int, int], list[Place]]:
+        """The fence places of ``belief``, keyed by ``(part, axis, sign)``: the part they are
+        for and the push (along ``axis``, towards ``sign``) that presses it against them."""
+        routes: dict[tuple[str, int, int], list[Place]] = {}
+        if not self.needs:
+            return routes
+        goal = self.problem.goal
+        # Fixtures of one shape are interchangeable: only the first of them off the table is
+        # offered (each would give the same belief under another name).
+        shapes: dict[object, str] = {}
+        for spec in self.problem.fixtures:
+            if spec.name not in belief:
+                shapes.setdefault(spec.shape.parts, spec.name)
+        free = list(shapes.values())
+        if not free:
+            return routes
+        for (part, axis), _ in self.needs.items():
+            interval = belief.get(part)
+            target = goal.target(part)
+            tolerance = goal.tolerance[axis]
+            other = 1 - axis
+            if interval is not None and (
+                abs(interval.center[axis] - target[axis]) + interval.half[axis] <= tolerance
+            ):
+                continue  # already within its goal along the axis
+            # Across the push: centred on the goal's coordinate and on the part's present one
+            # (its swath), each moved as little as keeps the fence on the table.
+            across = [target[other]]
+            if interval is not None and abs(interval.center[other] - target[other]) > 1e-6:
+                across.append(interval.center[other])
+            width = self.goal_boxes[part][other + 2] - self.goal_boxes[part][other]
+            for sign in (1, -1):
+                if (
+                    interval is not None
+                    and sign * (target[axis] - interval.center[axis]) < -tolerance
+                ):
+                    continue  # the fence would have the part pushed away from its goal
+                face = self.goal_face(part, axis, sign)
+                places = []
+                for fixture in free:
+                    for theta in fixture_angles(self.problem, fixture):
+                        box = self.checker.shadow_box(fixture, (0.0, 0.0, theta), _ZERO)
+                        shadow = self.checker.shadow_box(fixture, (0.0, 0.0, theta), self.place_unc)
+                        along = face - (box[axis] if sign > 0 else box[axis + 2])
+                        size = self.problem.table.size[other]
+                        for centre in dict.fromkeys(across):
+                            low = max(centre + COVER * width - box[other + 2], GAP - shadow[other])
+                            high = min(
+                                centre - COVER * width - box[other],
+                                size - GAP - shadow[other + 2],
+                            )
+                            if low > high:
+                                continue
+                            # nearest the centre first, then either end of the range (clear
+                            # of another fence there, say)
+                            for at in dict.fromkeys((min(max(centre, low), high), low, high)):
+                                pose = (along, at, theta) if axis == 0 else (at, along, theta)
+                                pose = (_round(pose[0]), _round(pose[1]), theta)
+                                if self.checker.shadow_inside_table(
+                                    fixture, pose, self.place_unc
+                                ) and self.checker.shadow_clear(
+                                    fixture, pose, self.place_unc, on_table
+                                ):
+                                    places.append(Place(fixture, pose))
+                if places:
+                    routes[(part, axis, sign)] = places
+        return routes
+
+    # -- using a fence -------------------------------------------------------------------------
+    def face_ahead(
+        self, part: str, interval, belief: IntervalBelief, axis: int, sign: int
+    ) -> float | None:
+        """The near face of a fixture on the table that holds ``part`` at its goal when pushed
+        along ``axis`` towards ``sign`` and lies ahead of its shadow (module docstring), or
+        None."""
+        found = self._fence_at(part, interval, belief, axis, sign)
+        if found is None:
+            return None
+        shadow = self.checker.shadow_box(part, interval.center, interval.half)
+        front = shadow[axis + 2] if sign > 0 else -shadow[axis]
+        return found[1] if sign * found[1] >= front - 1e-9 else None
+
+    def holding(self, belief: IntervalBelief, inside) -> set[str]:
+        """The fixtures on the table that hold a goal part at its goal along an axis that needs
+        a fence while the part still misses its goal along the other axis: picking one would
+        let the pushes still to come undo the fence's work. ``inside(part, axis)`` says
+        whether the part lies within its goal along ``axis``."""
+        held: set[str] = set()
+        for part, axis in self.needs:
+            interval = belief.get(part)
+            if interval is None or not inside(part, axis) or inside(part, 1 - axis):
+                continue
+            for sign in (1, -1):
+                found = self._fence_at(part, interval, belief, axis, sign)
+                if found is not None:
+                    held.add(found[0])
+        return held
+
+    def _fence_at(
+        self, part: str, interval, belief: IntervalBelief, axis: int, sign: int
+    ) -> tuple[str, float] | None:
+        """A fixture on the table (and its near face) whose near face, seen from ``part``
+        pushed along ``axis`` towards ``sign``, lies within the tolerance of the part's goal
+        face, and whose footprint covers the part's centre across the push."""
+        if part not in self.goal_boxes:
+            return None
+        goal_face = self.goal_face(part, axis, sign)
+        tolerance = self.problem.goal.tolerance[axis]
+        other = 1 - axis
+        goal_box = self.goal_boxes[part]
+        centre, spare = interval.center[other], COVER * (goal_box[other + 2] - goal_box[other])
+        for spec in self.problem.fixtures:
+            fixture = belief.get(spec.name)
+            if fixture is None:
+                continue
+            box = self.checker.shadow_box(spec.name, fixture.center, _ZERO)
+            face = box[axis] if sign > 0 else box[axis + 2]
+            if (
+                abs(face - goal_face) <= tolerance
+                and box[other] <= centre - spare + 1e-9
+                and centre + spare <= box[other + 2] + 1e-9
+            ):
+                return spec.name, face
+        return None

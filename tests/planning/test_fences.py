@@ -1,0 +1,152 @@
+"""Fixtures as planner actions (planning/fences.py): a goal part whose goal no free push can
+stop it within, on a table without the wall it needs, gets a fence the planner puts down and
+picks up again; problems that do not need one are planned as before."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pytest
+
+import arrange_up
+from arrange_up.belief.goals import GoalTest
+from arrange_up.belief.states import IntervalBelief, ObjectInterval
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.geometry.collision import CollisionChecker
+from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
+from arrange_up.io.yaml_problem import load_problem
+from arrange_up.model.problem import Uncertainty
+from arrange_up.model.world import Pick, Place, Push, WorldState
+from arrange_up.planning.actions import ActionGenerator
+from arrange_up.transitions import make_semantics
+from arrange_up.transitions.cbst import FIXTURE_REFUSAL
+
+FRESH = Path(__file__).parents[1] / "problems" / "fresh"
+
+
+@pytest.fixture(scope="module")
+def corner():
+    return load_problem(FRESH / "fence-corner.yaml")
+
+
+def _generator(problem):
+    return ActionGenerator(problem, CollisionChecker(problem))
+
+
+def test_a_fence_is_needed_only_where_a_free_push_cannot_stop_the_part(corner):
+    # x: push +-0.15 in and the stall's spread exceed the +-0.1 in tolerance, the place's
+    # +-0.03 in does not, and the table has no wall there; y: the bottom wall holds it.
+    assert set(_generator(corner).fences.needs) == {("A", 0)}
+
+
+@pytest.mark.parametrize("name", ["down-push", "create-a-t", "tz-mating", "tt-mating"])
+def test_no_shipped_problem_with_fixtures_needs_a_fence(name):
+    assert _generator(arrange_up.load(name)).fences.needs == {}
+
+
+def test_fence_places_stand_at_the_goal_face_and_replace_the_open_pushes_along_that_axis(corner):
+    gen = _generator(corner)
+    belief = IntervalBelief((("A", ObjectInterval((2.0, 0.5, 0.0), (0.1, 0.05, 0.05))),))
+    candidates = gen.candidates(belief)
+    fences = [a for a in candidates if isinstance(a, Place)]
+    # the bar's left face on A's goal face (x = 6.5), standing: as low as the bottom wall
+    # allows, then as high as it still covers A's centre with a quarter of A to spare
+    assert fences == [Place("bar", (6.65, 1.304473, 0.0)), Place("bar", (6.65, 1.5, 0.0))]
+    rightwards = [a for a in candidates if isinstance(a, Push) and abs(a.pose[2] + 1.5708) < 1e-3]
+    assert rightwards == []  # no push ending in the open along x while a fence can stand
+    fenced = IntervalBelief(
+        (*belief.objects, ("bar", ObjectInterval((6.65, 1.304473, 0.0), (0.03, 0.03, 0.035))))
+    )
+    pushes = [p for p in gen.pushes(fenced) if abs(p.pose[2] + 1.5708) < 1e-3]
+    assert len(pushes) == 1  # the one push: to the fence's face
+    paddle_front = pushes[0].pose[0] + 0.075
+    assert paddle_front + pushes[0].distance == pytest.approx(6.5, abs=1e-3)
+    assert Pick("bar") in gen.candidates(fenced)
+
+
+def test_a_fixture_put_down_must_be_picked_up_before_the_goal_is_reached(corner):
+    goal = GoalTest(corner)
+    at_goal = {"A": (6.0, 0.5, 0.0)}
+    assert goal.satisfied(WorldState.from_mapping(corner, at_goal))
+    left = WorldState.from_mapping(corner, {**at_goal, "bar": (6.65, 1.3, 0.0)})
+    assert not goal.satisfied(left)
+    (miss,) = goal.misses(left)
+    assert (miss.part, miss.dimensions()) == ("bar", ("on table",))
+
+
+# Successes of 40 rollouts (seed 0) the plans must reach, well below what they score (25 and
+# 40; the plans of the generator without fences score 23 and 29; the 200-rollout rates are in
+# docs/design/planning.md). The deterministic plan's approach poses ignore the initial spread,
+# so some of its pushes start overlapping the block.
+FLOORS = {"deterministic": 15, "particles": 32}
+
+
+@pytest.mark.parametrize("semantics", ["deterministic", "particles"])
+def test_the_planner_builds_its_own_fence_and_its_plan_reaches_the_goal_in_rollouts(
+    corner, semantics, tmp_path
+):
+    result = arrange_up.plan(corner, semantics=semantics, particles=6, workers=1)
+    assert result.solved, result.reason
+    kinds = [(type(a).__name__, getattr(a, "obj", None)) for a in result.actions]
+    assert ("Place", "bar") in kinds and result.actions[-1] == Pick("bar")
+    assert kinds.index(("Place", "bar")) < len(kinds) - 2  # a push between place and pick
+    # the plan file keeps the fence, and evaluate reads it back
+    path = tmp_path / "plan.json"
+    document = plan_document(
+        corner,
+        result.actions,
+        status=result.status,
+        semantics=result.semantics,
+        seed=result.seed,
+        search=result.stats,
+    )
+    write_json_atomic(path, document)
+    actions, read = read_plan(path, corner)
+    assert actions == result.actions and read["status"] == "solved"
+    reliability = evaluate_plan(corner, result.actions, rollouts=40, seed=0, workers=1)
+    assert reliability.successes >= FLOORS[semantics], reliability.failures
+
+
+def test_cbst_takes_a_fence_for_the_wall_ahead_and_refuses_one_the_block_may_slip_past(corner):
+    # CBST's training domain needs the thesis's +-0.05 in push noise
+    problem = dataclasses.replace(
+        corner,
+        uncertainty=Uncertainty(
+            place=(0.03, 0.03, math.radians(2)), push=(0.05, 0.05, math.radians(3))
+        ),
+    )
+    semantics = make_semantics("cbst", problem)
+    gen = ActionGenerator(
+        problem, CollisionChecker(problem), unclipped_pushes=True, settled_wall_pushes=True
+    )
+    block = ("A", ObjectInterval((4.0, 0.55, 0.0), (0.05, 0.05, 0.02)))
+    bar = ("bar", ObjectInterval((6.65, 1.304473, 0.0), (0.03, 0.03, math.radians(2))))
+    belief = IntervalBelief((block, bar))
+    (push,) = [p for p in gen.pushes(belief) if abs(p.pose[2] + math.pi / 2) < 1e-3]
+    after = semantics.apply(belief, push).get("A")
+    # pressed against the bar's face (x = 6.5): A's centre at 6 within the face's own spread
+    # (0.03 in of place, 2 degrees over the bar's 2.5 in) and the model's dx and slop
+    assert after.center[0] - after.half[0] < 6.0 < after.center[0] + after.half[0]
+    assert after.half[0] < 0.15
+    # the bar moved up: A's centre lies below its end, so A may slip past it
+    high = ("bar", ObjectInterval((6.65, 2.3, 0.0), bar[1].half))
+    longer = Push(push.manipulator, push.pose, push.distance + 0.1)
+    assert semantics.apply(IntervalBelief((block, high)), longer) is None
+    assert semantics.reasons[FIXTURE_REFUSAL] == 1
+
+
+def test_a_fence_holding_a_part_is_kept_while_the_part_has_pushes_to_come(corner):
+    gen = _generator(corner)
+    bar = ("bar", ObjectInterval((6.65, 2.0, 0.0), (0.03, 0.03, 0.035)))
+    at_x = ("A", ObjectInterval((6.0, 2.0, 0.0), (0.05, 0.3, 0.05)))  # x done, y still to go
+    assert Pick("bar") not in gen.candidates(IntervalBelief((at_x, bar)))
+    done = ("A", ObjectInterval((6.0, 0.55, 0.0), (0.05, 0.05, 0.05)))
+    assert Pick("bar") in gen.candidates(IntervalBelief((done, bar)))
+
+
+def test_a_fence_is_not_offered_where_its_own_place_is_as_uncertain_as_the_goal_is_tight():
+    # open-table-fence: the bar lands within +-0.2 in, the goal allows +-0.12 in
+    problem = load_problem(FRESH / "open-table-fence.yaml")
+    assert _generator(problem).fences.needs == {}
