@@ -118,6 +118,7 @@ ALTERNATIVES: dict[str, dict] = {
         "iterations": 5,
     },
     "rest_interval 0.00625, iterations 5": {"rest_interval": 0.00625, "iterations": 5},
+    "sleep 0.05": {"sleep_time": 0.05},
     "rest_interval 0.0125, tol 2.5e-4, iterations 5, sleep 0.05": {
         "rest_interval": 0.0125,
         "rest_linear_tol": 2.5e-4,
@@ -125,12 +126,26 @@ ALTERNATIVES: dict[str, dict] = {
         "iterations": 5,
         "sleep_time": 0.05,
     },
-    "rest_interval 0.0125, tol 2.5e-4, iterations 5, sleep 0.0125": {
+    "rest_interval 0.0125, tol 2.5e-4, iterations 5, sleep 0.025": {
         "rest_interval": 0.0125,
         "rest_linear_tol": 2.5e-4,
         "rest_angular_tol": 2.5e-4,
         "iterations": 5,
-        "sleep_time": 0.0125,
+        "sleep_time": 0.025,
+    },
+    "rest_interval 0.0125, tol 2.5e-4, iterations 3, sleep 0.05": {
+        "rest_interval": 0.0125,
+        "rest_linear_tol": 2.5e-4,
+        "rest_angular_tol": 2.5e-4,
+        "iterations": 3,
+        "sleep_time": 0.05,
+    },
+    "chosen: rest_interval 0.0125, tol 1.25e-4, iterations 5, sleep 0.05": {
+        "rest_interval": 0.0125,
+        "rest_linear_tol": 1.25e-4,
+        "rest_angular_tol": 1.25e-4,
+        "iterations": 5,
+        "sleep_time": 0.05,
     },
 }
 
@@ -260,11 +275,14 @@ def measure(
 
 
 def summary(rows: list[dict], label: str) -> dict:
-    """Median and max errors, mean steps, total seconds and status mismatches of one setting."""
+    """Median and max errors, mean steps, total seconds, status mismatches and the push of the
+    largest position error (``worst``) of one setting."""
     mine = [r for r in rows if r["setting"] == label]
     pos = [r["position_error"] for r in mine]
     ang = [r["angle_error"] for r in mine]
+    worst = max(mine, key=lambda r: r["position_error"])
     return {
+        "worst": f"{worst['case']} draw {worst['draw']}",
         "pushes": len(mine),
         "median_in": statistics.median(pos),
         "max_in": max(pos),
@@ -283,15 +301,15 @@ def _print_summaries(controller: str, rows: list[dict], labels) -> None:
         f"{statistics.fmean(r['reference_steps'] for r in rows if r['setting'] == labels[0]):.1f}"
     )
     print(
-        f"  {'setting':<36} {'median in':>9} {'max in':>7} {'median deg':>10} {'max deg':>7} "
-        f"{'steps':>6} {'x steps':>7} {'x time':>6} {'status!=':>8}"
+        f"  {'setting':<62} {'median in':>9} {'max in':>7} {'median deg':>10} {'max deg':>7} "
+        f"{'steps':>6} {'x steps':>7} {'x time':>6} {'status!=':>8}  worst push"
     )
     for label in labels:
         s = summary(rows, label)
         print(
-            f"  {label:<36} {s['median_in']:>9.4f} {s['max_in']:>7.4f} {s['median_deg']:>10.3f} "
+            f"  {label:<62} {s['median_in']:>9.4f} {s['max_in']:>7.4f} {s['median_deg']:>10.3f} "
             f"{s['max_deg']:>7.3f} {s['steps']:>6.1f} {s['steps'] / base['steps']:>7.2f} "
-            f"{s['seconds'] / base['seconds']:>6.2f} {s['status_differs']:>8}"
+            f"{s['seconds'] / base['seconds']:>6.2f} {s['status_differs']:>8}  {s['worst']}"
         )
 
 
@@ -361,7 +379,37 @@ def rollouts_per_second(
             f"new {new_rate:.2f} rollouts/s, {successes['new']}/{total} succeed; "
             f"new/old {new_rate / old_rate:.2f}x"
         )
-        print(f"  new settings: {_settings_record(new)}")
+
+
+#: Compliant goldens whose plans ``--evaluate`` scores under old and new settings.
+EVALUATED = (
+    "blocks-4-deterministic",
+    "blocks-7-deterministic",
+    "blocks-4-p25-s0",
+    "blocks-3-p25-s0",
+    "tz-mating-deterministic",
+    "repair-tz-mating-p10",
+    "tt-mating-deterministic",
+    "create-a-t-deterministic",
+)
+
+
+def success_counts(n: int, seed: int, new: PhysicsSettings) -> None:
+    """Successes of the plans of :data:`EVALUATED` (as the goldens of this checkout hold them)
+    in the same ``n`` rollouts (``seed``) under the old settings and ``new``."""
+    print(f"{'plan':<28} {'old':>9} {'new':>9} {'same outcome':>12}")
+    for case in EVALUATED:
+        data = json.loads((GOLDENS / f"{case}.json").read_text())
+        name = case.removeprefix("repair-").split("-p")[0].removesuffix("-deterministic")
+        problem = load(name)
+        actions = [_action(a) for a in data["actions"]]
+        old = Rollouts(problem, actions, OLD)
+        fresh = Rollouts(problem, actions, new)
+        a = [old.run(seed, i) for i in range(n)]
+        b = [fresh.run(seed, i) for i in range(n)]
+        same = sum(x.success == y.success for x, y in zip(a, b, strict=True))
+        wins_old, wins_new = sum(r.success for r in a), sum(r.success for r in b)
+        print(f"{case:<28} {wins_old:>5}/{n:<3} {wins_new:>5}/{n:<3} {same:>8}/{n}")
 
 
 def main() -> int:
@@ -376,11 +424,16 @@ def main() -> int:
     parser.add_argument("--rollouts", type=int, default=None)
     parser.add_argument("--rounds", type=int, default=4)
     parser.add_argument("--particle-plan", default=None)
+    parser.add_argument("--evaluate", type=int, default=None, metavar="N")
     args = parser.parse_args()
-    if args.rollouts is not None:
+    if args.rollouts is not None or args.evaluate is not None:
         new = DEFAULT_SETTINGS.for_controller(ControllerKind.COMPLIANT)
         new = replace(new, **_overrides(args.new or ()))
-        rollouts_per_second(args.rollouts, args.rounds, args.particle_plan, new)
+        print(f"new: {_settings_record(new)}")
+        if args.rollouts is not None:
+            rollouts_per_second(args.rollouts, args.rounds, args.particle_plan, new)
+        if args.evaluate is not None:
+            success_counts(args.evaluate, args.seed, new)
         return 0
     all_rows = []
     print(f"reference: {_settings_record(REFERENCE)}")
