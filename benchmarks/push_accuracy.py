@@ -39,8 +39,11 @@ table of ``docs/design/physics.md``) instead. ``--rollouts N`` measures rollouts
 evaluation under old and new settings, paired (alternating rounds in one process, medians): the
 servo CBST plan of blocks-7 under the servo and a compliant particle plan of blocks-7 (no CBST
 plan of blocks-7 exists under the compliant controller, whose learned model plans nothing
-there; ``--particle-plan`` names a plan file, by default one is planned with 10 particles,
-seed 0), with their success counts over the same rollout seeds.
+there; ``--particle-plan`` names a plan file, by default one is planned with 25 particles,
+seed 0), with their success counts over the same rollout seeds. ``--evaluate N`` prints the
+successes of the compliant goldens' plans (:data:`EVALUATED`) in the same ``N`` rollouts under
+old and new settings; ``--saturation`` counts the steps during which an exact early exit at a
+stall could have ended a compliant push (the set point still moving, the force clipped).
 """
 
 from __future__ import annotations
@@ -73,8 +76,13 @@ from arrange_up.model.world import (
     nominal_noise,
 )
 from arrange_up.physics.bench import scene
-from arrange_up.physics.settings import DEFAULT_SETTINGS, SERVO_VALUES, PhysicsSettings
-from arrange_up.physics.simulation import simulate
+from arrange_up.physics.settings import (
+    DEFAULT_SETTINGS,
+    SERVO_VALUES,
+    PhysicsSettings,
+    push_force,
+)
+from arrange_up.physics.simulation import simulate, simulate_watched
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDENS = ROOT / "tests" / "goldens"
@@ -331,6 +339,55 @@ def _settings_record(s: PhysicsSettings) -> str:
     return json.dumps({k: v for k, v in asdict(s).items()}, sort_keys=True)
 
 
+def _particle_plan(problem: ArrangementProblem, path: str | None) -> tuple[Action, ...]:
+    """The compliant particle plan of blocks-7: read from ``path``, or planned (25 particles,
+    seed 0, one worker)."""
+    if path is not None:
+        return read_plan(path, problem)[0]
+    from arrange_up.planning.planner import plan  # noqa: PLC0415 - only for these modes
+
+    t0 = time.perf_counter()
+    result = plan(problem, semantics="particles", particles=25, seed=0, workers=1)
+    print(
+        f"planned blocks-7 (particles 25, seed 0): {result.status} in "
+        f"{time.perf_counter() - t0:.0f} s"
+    )
+    if not result.solved:
+        sys.exit("no compliant particle plan of blocks-7")
+    return tuple(result.actions)
+
+
+def saturation(particle_plan: str | None) -> None:
+    """Steps, over the compliant catalogue's pushes and the particle plan's (noise-free, the
+    compliant defaults), during which the set point was still moving while the controller's
+    force was clipped along the push: the steps an exact early exit at a stall could save."""
+    problem = load("blocks-7")
+    cases = catalogue(ControllerKind.COMPLIANT)
+    cases += _plan_cases("blocks-7 particles", problem, _particle_plan(problem, particle_plan))
+    saturated = total = 0
+    for case in cases:
+        paddle: list = []
+
+        def watch(bodies, paddle=paddle) -> None:
+            if bodies is not None:  # None marks the drive's end
+                paddle.append(bodies[-1])
+
+        simulate_watched(case.problem, case.state, case.push, watch, nominal_noise(case.problem))
+        controller = case.problem.controller
+        clip = push_force(case.problem) if controller.force is None else controller.force
+        reach = (controller.speed or DEFAULT_SETTINGS.push_speed) * DEFAULT_SETTINGS.dt
+        x0, y0 = paddle[0][0], paddle[0][1]
+        for k, (x, y, *_) in enumerate(paddle[1:], start=1):
+            if k * reach >= case.push.distance:
+                break
+            saturated += controller.kp * (k * reach - math.hypot(x - x0, y - y0)) > clip
+        total += len(paddle)
+    print(
+        f"{len(cases)} pushes: force clipped while the set point moved in {saturated} of "
+        f"{total} steps"
+    )
+
+
 def rollouts_per_second(
     n: int, rounds: int, particle_plan: str | None, new: PhysicsSettings
 ) -> None:
@@ -340,20 +397,7 @@ def rollouts_per_second(
     data = json.loads((GOLDENS / "servo-blocks-7-cbst.json").read_text())
     servo_plan = tuple(_action(a) for a in data["actions"])
     compliant_problem = load("blocks-7")
-    if particle_plan is None:
-        from arrange_up.planning.planner import plan  # noqa: PLC0415 - only for this mode
-
-        t0 = time.perf_counter()
-        result = plan(compliant_problem, semantics="particles", particles=10, seed=0, workers=1)
-        print(
-            f"planned blocks-7 (particles 10, seed 0): {result.status} in "
-            f"{time.perf_counter() - t0:.0f} s"
-        )
-        if not result.solved:
-            sys.exit("no compliant particle plan of blocks-7")
-        compliant_plan = tuple(result.actions)
-    else:
-        compliant_plan, _ = read_plan(particle_plan, compliant_problem)
+    compliant_plan = _particle_plan(compliant_problem, particle_plan)
     for title, problem, actions in (
         ("servo CBST plan of blocks-7, controller servo", servo_problem, servo_plan),
         ("compliant particle plan of blocks-7", compliant_problem, compliant_plan),
@@ -425,7 +469,11 @@ def main() -> int:
     parser.add_argument("--rounds", type=int, default=4)
     parser.add_argument("--particle-plan", default=None)
     parser.add_argument("--evaluate", type=int, default=None, metavar="N")
+    parser.add_argument("--saturation", action="store_true")
     args = parser.parse_args()
+    if args.saturation:
+        saturation(args.particle_plan)
+        return 0
     if args.rollouts is not None or args.evaluate is not None:
         new = DEFAULT_SETTINGS.for_controller(ControllerKind.COMPLIANT)
         new = replace(new, **_overrides(args.new or ()))
