@@ -34,8 +34,8 @@ class PhysicsSettings:
     dt: float = 1.0 / 240.0
     """Time step. 1/60 is too coarse for chains of blocks (see ``docs/design/physics.md``)."""
     iterations: int | None = None
-    """Solver iterations per step; ``None``: the controller's (10 for both: the safe end of
-    the accurate range at dt 1/240; :data:`CONTROLLER_VALUES`)."""
+    """Solver iterations per step; ``None``: the controller's (:data:`CONTROLLER_VALUES`; the
+    servo 10, the safe end of the accurate range at dt 1/240; the compliant controller 5)."""
     collision_slop: float = 0.005
     """Allowed resting overlap (in). pymunk's default 0.1 is sized for pixels."""
     collision_bias: float = 0.8**240
@@ -47,19 +47,23 @@ class PhysicsSettings:
     """Standard gravity in in/s^2; only the table friction uses it (the world is top-down)."""
     rest_interval: float | None = None
     """Simulated time between rest checks (s), rounded to whole steps; ``None``: the
-    controller's (0.1 s, 24 steps at dt 1/240, for both; :data:`CONTROLLER_VALUES`)."""
+    controller's (:data:`CONTROLLER_VALUES`; the servo 0.1 s, 24 steps at dt 1/240; the
+    compliant controller 0.0125 s, 3 steps)."""
     rest_linear_tol: float | None = None
     """A body is still when it moved less than this (in) since the previous check...
-    (``None``: the controller's, 1e-3 for both)"""
+    (``None``: the controller's, the servo 1e-3, the compliant controller 1.25e-4: both
+    0.01 in/s at their intervals)"""
     rest_angular_tol: float | None = None
-    """...and turned less than this (rad) (``None``: the controller's, 1e-3 for both)."""
+    """...and turned less than this (rad) (``None``: the controller's, the servo 1e-3, the
+    compliant controller 1.25e-4)."""
     rest_checks: int | None = None
     """Consecutive still checks that make rest (one can be a momentary stop); ``None``: the
     controller's (2 for both)."""
     sleep_time: float | None = None
     """Bodies idle (slower than ``rest_linear_tol / rest_interval``) for this long (s) sleep:
     the engine stops solving them and their joints until something touches them; 0 turns
-    sleeping off. ``None``: the controller's (0 for both; :data:`CONTROLLER_VALUES`)."""
+    sleeping off. ``None``: the controller's (the servo 0, the compliant controller 0.05;
+    :data:`CONTROLLER_VALUES`)."""
     max_time: float = 20.0
     """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
     settle_steps: int = 2
@@ -158,9 +162,20 @@ SERVO_VALUES: dict[str, float | int] = {
 per controller. The servo keeps them, so that its plans, goldens and measurements stay
 reproducible bit for bit (``docs/design/physics.md``)."""
 
-COMPLIANT_VALUES: dict[str, float | int] = dict(SERVO_VALUES)
+COMPLIANT_VALUES: dict[str, float | int] = {
+    "iterations": 5,
+    "rest_interval": 0.0125,
+    "rest_linear_tol": 1.25e-4,
+    "rest_angular_tol": 1.25e-4,
+    "rest_checks": 2,
+    "sleep_time": 0.05,
+}
 """The compliant controller's settling and rest settings, chosen on the accuracy benchmark
-(``benchmarks/push_accuracy.py``; the alternatives measured are in ``docs/design/physics.md``)."""
+(``benchmarks/push_accuracy.py``; the alternatives measured are in ``docs/design/physics.md``):
+a check every 3 steps (0.0125 s) with the old speed threshold (1.25e-4 in per check is the old
+1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep. About
+0.7x the steps and 0.55-0.6x the time of the servo's values, final poses as close to the
+reference."""
 
 CONTROLLER_VALUES: dict[ControllerKind, dict[str, float | int]] = {
     ControllerKind.SERVO: SERVO_VALUES,

@@ -102,3 +102,15 @@ def test_sleeping_skips_idle_bodies_without_moving_them():
     (xa, ya, ta), (xb, yb, tb) = a.state.pose("near"), b.state.pose("near")
     assert math.hypot(xa - xb, ya - yb) < 0.005 and abs(ta - tb) < 0.005
     assert xb > 3.0 + 1.0  # it was pushed
+
+
+def test_compliant_defaults_take_fewer_steps_to_the_same_rest():
+    """The compliant controller's values end a push in fewer steps than the servo's values
+    would, with the pushed block where they would leave it (within 0.01 in)."""
+    problem = _problem(servo=False)
+    old = _run(problem, dataclasses.replace(DEFAULT_SETTINGS, **SERVO_VALUES), 0.55)
+    new = _run(problem, DEFAULT_SETTINGS, 0.55)
+    assert new.status is StepStatus.OK and old.status is StepStatus.OK
+    assert new.steps < 0.8 * old.steps
+    (xo, yo, to), (xn, yn, tn) = old.state.pose("near"), new.state.pose("near")
+    assert math.hypot(xo - xn, yo - yn) < 0.01 and abs(to - tn) < 0.01
