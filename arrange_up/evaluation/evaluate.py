@@ -138,9 +138,11 @@ def evaluate_plan(
     file = None
     records: dict[int, RolloutRecord] = {}
     if record is not None:
-        # The landing rule changes outcomes: a shoving evaluation hashes its settings with it
-        # (a failing one as before, so existing record files resume).
-        physics = DEFAULT_SETTINGS if landing == "fail" else (DEFAULT_SETTINGS, landing)
+        # The landing rule changes outcomes: a shoving evaluation hashes its settings with it.
+        # The settings are hashed as the problem's controller resolves them, so a record file
+        # made under other settling or rest values of that controller does not resume.
+        settings = DEFAULT_SETTINGS.for_controller(problem.controller.kind)
+        physics = settings if landing == "fail" else (settings, landing)
         header = record_header(problem, phash, lhash, len(actions), seed, physics)
         file = RecordFile(Path(record), header)
         records = {i: r for i, r in file.records.items() if i < rollouts}

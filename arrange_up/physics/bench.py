@@ -45,6 +45,7 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.world import ActionNoise, Push, WorldState, draw_noise
 from arrange_up.parallel import local_executor
+from arrange_up.physics.settings import SERVO_VALUES
 from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus, simulate
 
 SCENES: tuple[str, ...] = ("1 block", "3-block chain", "7-block chain")
@@ -255,7 +256,9 @@ def compare_settings(
 
 
 def _settings_of(assignments: Sequence[str]) -> PhysicsSettings:
-    """``PhysicsSettings`` with ``KEY=VALUE`` overrides (values as fractions: ``dt=1/960``)."""
+    """``PhysicsSettings`` with ``KEY=VALUE`` overrides (values as fractions: ``dt=1/960``) of
+    the settings before they were chosen per controller (``SERVO_VALUES`` for both
+    controllers), which the comparisons of ``docs/design/physics.md`` were measured against."""
     changes: dict[str, float | int] = {}
     for item in assignments:
         key, _, value = item.partition("=")
@@ -263,7 +266,7 @@ def _settings_of(assignments: Sequence[str]) -> PhysicsSettings:
         changes[key] = (
             int(number) if number.denominator == 1 and "." not in value else float(number)
         )
-    return replace(DEFAULT_SETTINGS, **changes)
+    return replace(DEFAULT_SETTINGS, **{**SERVO_VALUES, **changes})
 
 
 def format_rows(rows: Sequence[dict]) -> str:
@@ -291,7 +294,8 @@ if __name__ == "__main__":  # pragma: no cover - quick manual runs
         "--compare",
         nargs="*",
         metavar="KEY=VALUE",
-        help="instead of timing: final poses under these settings against --reference's",
+        help="instead of timing: final poses under these settings against --reference's "
+        "(both overrides of the settings before they were chosen per controller)",
     )
     parser.add_argument("--reference", nargs="*", metavar="KEY=VALUE", default=[])
     args = parser.parse_args()

@@ -5,25 +5,37 @@ in :mod:`arrange_up.physics.simulation`."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from arrange_up.model.problem import STANDARD_GRAVITY, ArrangementProblem
+from arrange_up.model.problem import STANDARD_GRAVITY, ArrangementProblem, ControllerKind
 
-__all__ = ["DEFAULT_SETTINGS", "PhysicsSettings", "pd_gains", "push_force"]
+__all__ = [
+    "COMPLIANT_VALUES",
+    "CONTROLLER_VALUES",
+    "DEFAULT_SETTINGS",
+    "SERVO_VALUES",
+    "PhysicsSettings",
+    "pd_gains",
+    "push_force",
+]
 
 
 @dataclass(frozen=True)
 class PhysicsSettings:
     """Numerical and controller settings of the simulation (inches, seconds, radians).
 
-    Every default is argued in :mod:`arrange_up.physics.simulation` or measured in
+    The settling and rest fields (``iterations``, ``rest_*``, ``sleep_time``) default to
+    ``None``: a push takes its controller's values (:meth:`for_controller`,
+    :data:`CONTROLLER_VALUES`); a value given explicitly holds for both controllers. Every
+    default is argued in :mod:`arrange_up.physics.simulation` or measured in
     ``docs/design/physics.md``.
     """
 
     dt: float = 1.0 / 240.0
     """Time step. 1/60 is too coarse for chains of blocks (see ``docs/design/physics.md``)."""
-    iterations: int = 10
-    """Solver iterations per step (10: the safe end of the accurate range at dt 1/240)."""
+    iterations: int | None = None
+    """Solver iterations per step; ``None``: the controller's (:data:`CONTROLLER_VALUES`; the
+    servo 10, the safe end of the accurate range at dt 1/240; the compliant controller 5)."""
     collision_slop: float = 0.005
     """Allowed resting overlap (in). pymunk's default 0.1 is sized for pixels."""
     collision_bias: float = 0.8**240
@@ -33,14 +45,25 @@ class PhysicsSettings:
     :mod:`arrange_up.physics.simulation`)."""
     gravity: float = STANDARD_GRAVITY
     """Standard gravity in in/s^2; only the table friction uses it (the world is top-down)."""
-    rest_interval: float = 0.1
-    """Simulated time between rest checks (s); rounded to whole steps (24 at dt 1/240)."""
-    rest_linear_tol: float = 1e-3
-    """A body is still when it moved less than this (in) since the previous check..."""
-    rest_angular_tol: float = 1e-3
-    """...and turned less than this (rad)."""
-    rest_checks: int = 2
-    """Consecutive still checks that make rest (one can be a momentary stop)."""
+    rest_interval: float | None = None
+    """Simulated time between rest checks (s), rounded to whole steps; ``None``: the
+    controller's (:data:`CONTROLLER_VALUES`; the servo 0.1 s, 24 steps at dt 1/240; the
+    compliant controller 0.0125 s, 3 steps)."""
+    rest_linear_tol: float | None = None
+    """A body is still when it moved less than this (in) since the previous check...
+    (``None``: the controller's, the servo 1e-3, the compliant controller 1.25e-4: both
+    0.01 in/s at their intervals)"""
+    rest_angular_tol: float | None = None
+    """...and turned less than this (rad) (``None``: the controller's, the servo 1e-3, the
+    compliant controller 1.25e-4)."""
+    rest_checks: int | None = None
+    """Consecutive still checks that make rest (one can be a momentary stop); ``None``: the
+    controller's (2 for both)."""
+    sleep_time: float | None = None
+    """Bodies idle (slower than ``rest_linear_tol / rest_interval``) for this long (s) sleep:
+    the engine stops solving them and their joints until something touches them; 0 turns
+    sleeping off. ``None``: the controller's (the servo 0, the compliant controller 0.05;
+    :data:`CONTROLLER_VALUES`)."""
     max_time: float = 20.0
     """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
     settle_steps: int = 2
@@ -79,15 +102,19 @@ class PhysicsSettings:
         )
         for name in positive:
             value = getattr(self, name)
+            if value is None and name in CONTROLLER_VALUES[ControllerKind.SERVO]:
+                continue
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(
                     f"PhysicsSettings.{name} must be positive and finite, got {value!r}"
                 )
-        for name in ("rest_linear_tol", "rest_angular_tol", "overlap_tolerance"):
-            if not getattr(self, name) >= 0:
+        for name in ("rest_linear_tol", "rest_angular_tol", "overlap_tolerance", "sleep_time"):
+            value = getattr(self, name)
+            if value is not None and not value >= 0:
                 raise ValueError(f"PhysicsSettings.{name} must be non-negative")
         for name in ("iterations", "rest_checks"):
-            if getattr(self, name) < 1:
+            value = getattr(self, name)
+            if value is not None and value < 1:
                 raise ValueError(f"PhysicsSettings.{name} must be at least 1")
         if not 0.0 <= self.collision_bias <= 1.0:
             raise ValueError("PhysicsSettings.collision_bias must be in [0, 1]")
@@ -104,9 +131,17 @@ class PhysicsSettings:
         """Rate (1/s) of the position loop, ``Kp / Kd = 1 / (4 damping_ratio^2 dt)``."""
         return 1.0 / (4.0 * self.damping_ratio * self.damping_ratio * self.dt)
 
+    def for_controller(self, kind: ControllerKind) -> PhysicsSettings:
+        """These settings with every ``None`` field at the value of controller ``kind``
+        (:data:`CONTROLLER_VALUES`); fields given explicitly hold for every controller."""
+        values = CONTROLLER_VALUES[kind]
+        return replace(self, **{k: v for k, v in values.items() if getattr(self, k) is None})
+
     @property
     def interval_steps(self) -> int:
-        """Steps between rest checks."""
+        """Steps between rest checks (of settings resolved by :meth:`for_controller`)."""
+        if self.rest_interval is None:
+            raise ValueError("PhysicsSettings.rest_interval is None: resolve with for_controller")
         return max(1, round(self.rest_interval / self.dt))
 
     @property
@@ -115,7 +150,43 @@ class PhysicsSettings:
         return max(1, math.ceil(self.max_time / self.dt - 1e-9))
 
 
+SERVO_VALUES: dict[str, float | int] = {
+    "iterations": 10,
+    "rest_interval": 0.1,
+    "rest_linear_tol": 1e-3,
+    "rest_angular_tol": 1e-3,
+    "rest_checks": 2,
+    "sleep_time": 0.0,
+}
+"""The servo's settling and rest settings: those every push used before they were chosen
+per controller. The servo keeps them, so that its plans, goldens and measurements stay
+reproducible bit for bit (``docs/design/physics.md``)."""
+
+COMPLIANT_VALUES: dict[str, float | int] = {
+    "iterations": 5,
+    "rest_interval": 0.0125,
+    "rest_linear_tol": 1.25e-4,
+    "rest_angular_tol": 1.25e-4,
+    "rest_checks": 2,
+    "sleep_time": 0.05,
+}
+"""The compliant controller's settling and rest settings, chosen on the accuracy benchmark
+(``benchmarks/push_accuracy.py``; the alternatives measured are in ``docs/design/physics.md``):
+a check every 3 steps (0.0125 s) with the old speed threshold (1.25e-4 in per check is the old
+1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep. About
+0.7x the steps and 0.55-0.6x the time of the servo's values, final poses as close to the
+reference."""
+
+CONTROLLER_VALUES: dict[ControllerKind, dict[str, float | int]] = {
+    ControllerKind.SERVO: SERVO_VALUES,
+    ControllerKind.COMPLIANT: COMPLIANT_VALUES,
+}
+"""controller kind -> the values :meth:`PhysicsSettings.for_controller` gives the ``None``
+fields."""
+
 DEFAULT_SETTINGS = PhysicsSettings()
+"""The defaults: the settling and rest fields ``None``, so that each push takes its
+controller's (:data:`CONTROLLER_VALUES`)."""
 
 
 def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS) -> float:

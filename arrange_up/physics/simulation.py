@@ -133,15 +133,23 @@ damped PD at ``sqrt(Kp / m) dt`` ~ 0.19). Defaults (``Kp = 300``) and their meas
 Rest
 ====
 Rest is judged from pose change, not velocity (bodies being separated move while reporting zero
-velocity): every ``rest_interval`` (0.1 s) of simulated time each body's pose is compared with
+velocity): every ``rest_interval`` of simulated time each body's pose is compared with
 the previous check; a body is still when it moved less than ``rest_linear_tol`` inches and
-``rest_angular_tol`` radians. The drive stops when the paddle was still ``rest_checks`` (2)
+``rest_angular_tol`` radians. The drive stops when the paddle was still ``rest_checks``
 checks in a row; the push ends when every other body was still ``rest_checks`` checks in a row,
 at least one of them after the drive stopped (the other bodies are watched from the first
 check at which the paddle is still, so the check that stops the drive can count: that saves
 one interval per push and still ends every push with two consecutive still checks of every
 body). The whole push is capped at ``max_time`` (20 s) of simulated time; a cap hit is reported
 as ``NOT_AT_REST`` with the poses at the cap, never silently truncated.
+
+These rest settings, the solver ``iterations`` and body sleeping (``sleep_time``: bodies idle
+that long are no longer solved until something touches them) are chosen per controller
+(:meth:`PhysicsSettings.for_controller`, :data:`~arrange_up.physics.settings.CONTROLLER_VALUES`):
+the servo keeps the values every push had before (a check every 0.1 s, two checks, 10
+iterations, no sleeping), so that its plans and measurements stay reproducible bit for bit; the
+compliant controller's were chosen on the accuracy benchmark ``benchmarks/push_accuracy.py``
+(``docs/design/physics.md``).
 
 Overlaps beyond the slop are pushed apart at 20% per step (``collision_bias``, Box2D's
 Baumgarte factor) rather than pymunk's default 2.6%: a chain that hits a wall at 3 in/s is
@@ -408,6 +416,8 @@ def _push(
     if not all(math.isfinite(v) for v in action.pose):
         raise ValueError(f"push: approach pose must be finite, got {action.pose!r}")
     _check_noise(noise)
+    controller = compiled.problem.controller
+    s = s.for_controller(controller.kind)
     mu = float(noise.friction)
     g = s.gravity
     shape_mu = math.sqrt(mu)
@@ -431,6 +441,9 @@ def _push(
         lib.cpSpaceSetIterations(space, s.iterations)
         lib.cpSpaceSetCollisionSlop(space, s.collision_slop)
         lib.cpSpaceSetCollisionBias(space, s.collision_bias)
+        if s.sleep_time > 0.0:
+            lib.cpSpaceSetSleepTimeThreshold(space, s.sleep_time)
+            lib.cpSpaceSetIdleSpeedThreshold(space, s.rest_linear_tol / s.rest_interval)
         static = lib.cpSpaceGetStaticBody(space)
 
         def add_body(body, body_def, x: float, y: float, th: float) -> None:
@@ -491,7 +504,6 @@ def _push(
         ox, oy, oth = noise.pose_offset
         px, py, pth = action.pose
         px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
-        controller = compiled.problem.controller
         compliant = controller.kind is ControllerKind.COMPLIANT
         rho_m = noise.manipulator_density
         paddle_mass = rho_m * paddle_def.area
@@ -844,6 +856,7 @@ def _drive_trajectory(
     :func:`simulate` uses (:func:`_add_drive`); the tests compare this with the clipped PD it
     implements.
     """
+    settings = settings.for_controller(ControllerKind.SERVO)
     space = lib.cpSpaceNew()
     paddle = lib.cpBodyNew(mass, math.inf)
     drive = None

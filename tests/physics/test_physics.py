@@ -16,6 +16,7 @@ import pytest
 from arrange_up.model.problem import (
     SERVO_CONTROLLER,
     ArrangementProblem,
+    ControllerKind,
     Goal,
     ObjectKind,
     ObjectSpec,
@@ -399,7 +400,7 @@ def test_settings_validation():
         PhysicsSettings(dt=0.0)
     with pytest.raises(ValueError):
         PhysicsSettings(damping_ratio=0.3)
-    assert DEFAULT_SETTINGS.interval_steps == 24
+    assert DEFAULT_SETTINGS.for_controller(ControllerKind.SERVO).interval_steps == 24
     assert DEFAULT_SETTINGS.max_steps == 4800
 
 
