@@ -63,7 +63,7 @@ from matplotlib.patches import Patch
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.records import plan_hash
 from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
-from arrange_up.experiments.problems import controller_setting, driven_problems
+from arrange_up.experiments.problems import controller_setting, driven_problems, physics_setting
 from arrange_up.figures.backend import pyplot
 from arrange_up.model.world import Push
 from arrange_up.parallel import available_cores
@@ -224,7 +224,12 @@ def fixture_experiment(
             **{kind: getattr(result.failures, kind) for kind in FAILURE_KINDS},
         }
 
-    settings = {"rollouts": rollouts, "timeout": timeout, "controller": controller_setting(loaded)}
+    settings = {
+        "rollouts": rollouts,
+        "timeout": timeout,
+        "controller": controller_setting(loaded),
+        "physics": physics_setting(loaded),
+    }
     with CsvAppender(path, FIXTURE_FIELDS, key=_KEY, settings=settings) as append:
         existing = read_csv(path)  # under the lock: what an earlier run measured
         done = append.done  # grows as rows are written: a repeated problem or count is done too

@@ -33,7 +33,7 @@ from matplotlib.patches import Patch
 
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
-from arrange_up.experiments.problems import controller_setting, driven_problems
+from arrange_up.experiments.problems import controller_setting, driven_problems, physics_setting
 from arrange_up.figures.backend import pyplot
 from arrange_up.parallel import available_cores
 from arrange_up.planning.planner import plan
@@ -131,6 +131,7 @@ def transition_comparison(
         "max_nodes": max_nodes,
         "timeout": timeout,
         "controller": controller_setting(loaded),
+        "physics": physics_setting(loaded),
     }
     with CsvAppender(path, TRANSITION_FIELDS, key=_TRANSITION_KEY, settings=settings) as write:
         done = write.done  # grows as rows are written: a repeated planner is measured once
@@ -250,6 +251,7 @@ def search_table(
         "weight": weight,
         "timeout": timeout,
         "controller": controller_setting(loaded),
+        "physics": physics_setting(loaded),
     }
     with CsvAppender(path, SEARCH_FIELDS, key=_SEARCH_KEY, settings=settings) as write:
         done = write.done  # grows as rows are written: a repeated problem is measured once

@@ -1,15 +1,20 @@
 """The problems an experiment measures, driven by the controller it was asked for, and how that
 controller is recorded (a ``controller`` column in every row and a ``controller`` setting of the
-CSV, so that rows measured under different controllers are never mixed)."""
+CSV, so that rows measured under different controllers are never mixed), with the physics
+settings it resolves to (a ``physics`` setting: rows simulated with other settling and rest
+settings are never mixed either)."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 from arrange_up.io.domains import load
 from arrange_up.model.problem import ArrangementProblem, driven_by
+from arrange_up.physics.settings import DEFAULT_SETTINGS
 
-__all__ = ["controller_setting", "driven_problems"]
+__all__ = ["controller_setting", "driven_problems", "physics_setting"]
 
 
 def driven_problems(names: Sequence[str], controller: str | None) -> dict[str, ArrangementProblem]:
@@ -26,3 +31,11 @@ def controller_setting(problems: Mapping[str, ArrangementProblem]) -> str:
     """The CSV setting naming the controller kind the problems are driven by (the kinds in
     alphabetical order, comma-separated, if they differ)."""
     return ",".join(sorted({problem.controller.kind.value for problem in problems.values()}))
+
+
+def physics_setting(problems: Mapping[str, ArrangementProblem]) -> dict[str, dict[str, Any]]:
+    """The CSV setting naming the physics settings the problems are simulated with: for each
+    controller kind among them, the default settings as that kind resolves them
+    (:meth:`~arrange_up.physics.settings.PhysicsSettings.for_controller`)."""
+    kinds = sorted({problem.controller.kind for problem in problems.values()}, key=str)
+    return {kind.value: dataclasses.asdict(DEFAULT_SETTINGS.for_controller(kind)) for kind in kinds}

@@ -25,10 +25,12 @@ from arrange_up.experiments.planning import (
     search_table,
     transition_comparison,
 )
+from arrange_up.experiments.problems import physics_setting
 from arrange_up.io.domains import load
 from arrange_up.model.problem import SERVO_CONTROLLER, ControllerKind, driven_by
 from arrange_up.repair import nominal_plans
 
+SERVO_PROBLEM = driven_by(load("blocks-1"), "servo")
 SERVO_RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results" / "servo"
 DETERMINISTIC = [Planner("deterministic", "deterministic", 1)]
 
@@ -148,11 +150,29 @@ def test_the_servo_csvs_load_with_their_controller(tmp_path, name, fields):
     copy = tmp_path / path.name
     shutil.copy(path, copy)
     shutil.copy(path.with_name(f"{name}.settings.json"), tmp_path)
-    with CsvAppender(copy, fields, settings={**documented, "controller": "servo"}):
+    servo = {"controller": "servo", "physics": physics_setting({"p": SERVO_PROBLEM})}
+    with CsvAppender(copy, fields, settings={**documented, **servo}):
         pass
     with pytest.raises(CsvRecordsError, match="controller"):
-        with CsvAppender(copy, fields, settings={**documented, "controller": "compliant"}):
+        with CsvAppender(copy, fields, settings={**documented, **servo, "controller": "compliant"}):
             pass
+
+
+def test_the_physics_settings_are_recorded_and_never_mixed(tmp_path):
+    # Each controller's resolved settling and rest settings are a setting of the CSV: rows
+    # simulated with the compliant controller's old settings (a settings file without them, as
+    # the compliant CSVs measured before it had its own) are refused, not resumed.
+    compliant = physics_setting({"p": load("blocks-1")})
+    servo = physics_setting({"p": SERVO_PROBLEM})
+    assert set(compliant) == {"compliant"} and set(servo) == {"servo"}
+    assert compliant["compliant"]["rest_interval"] != servo["servo"]["rest_interval"]
+    path = search_table(tmp_path, problems=("blocks-1",), max_nodes=20)
+    assert settings(path)["physics"] == compliant
+    kept = settings(path)
+    del kept["physics"]
+    path.with_name(f"{path.stem}.settings.json").write_text(json.dumps(kept))
+    with pytest.raises(CsvRecordsError, match="physics: the CSV's None"):
+        search_table(tmp_path, problems=("blocks-1",), max_nodes=20)
 
 
 def test_the_documented_servo_commands_find_every_measurement_done():
