@@ -172,8 +172,10 @@ class Pending(Generic[R]):
         """True when :meth:`result` would not wait."""
         return True
 
-    def cancel(self) -> None:
-        """Drop the task if it has not started (its result is not wanted)."""
+    def cancel(self) -> bool:
+        """Drop the task if it has not started (its result is not wanted): True when it will
+        not run (it was still queued), False when it may have run or be running."""
+        return False
 
 
 class Session(Generic[T, R]):
@@ -386,8 +388,8 @@ class _LocalPending(Pending[R]):
                 continue
             return value
 
-    def cancel(self) -> None:
-        self.future.cancel()
+    def cancel(self) -> bool:
+        return bool(self.future.cancel())
 
 
 class _LocalSession(Session[T, R]):
@@ -506,8 +508,9 @@ class _DaskPending(Pending[R]):
                 self.session.rescatter()
                 self.future = self.session.send(self.item)
 
-    def cancel(self) -> None:
+    def cancel(self) -> bool:
         self.future.cancel()
+        return False  # the scheduler may have started it already: nobody can tell from here
 
 
 class _DaskSession(Session[T, R]):

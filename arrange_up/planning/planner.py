@@ -314,7 +314,7 @@ def plan(
                 tie_break_seed=seed if tie_break else None,
                 progress=report,
                 should_stop=should_stop,
-                prefetch=evaluator.prefetch if runner.workers > 1 else None,
+                prefetch=evaluator.prefetch if evaluator.ahead else None,
                 prefetch_depth=PREFETCH_DEPTH,
             )
     finally:

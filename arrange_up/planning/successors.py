@@ -52,8 +52,9 @@ __all__ = ["FIRST_SHARE", "SuccessorEvaluator", "WorkerSpec", "first_share"]
 
 #: Most particles, as a fraction of a belief's, that a staged push simulates first.
 FIRST_SHARE = 0.5
-#: Edges handed to the workers ahead, per worker.
-AHEAD_PER_WORKER = 2
+#: Jobs in the workers' hands at once, per worker: one running, none queued, so a job the
+#: search asks for is never queued behind work sent ahead (it is computed here instead).
+AHEAD_PER_WORKER = 1
 #: Children computed ahead and not yet asked for that are kept; older ones are dropped (and
 #: computed again if asked for), so a long search does not hoard unread beliefs.
 KEPT_AHEAD = 2048
@@ -130,134 +131,128 @@ class _InProcess:
 
 @dataclass(frozen=True)
 class _Answer:
-    """A job's result: the child (None: no prediction; for a first share, a belief whose box
-    lies inside the child's), its heuristic value when asked for, for a first share what the
-    rest needs (its particles, their outcomes, the pushed objects), and the simulations run."""
+    """A job's result: the child (None: no prediction) and its heuristic value when asked
+    for (``whole``), or a share's :class:`~arrange_up.transitions.particles.PushBatch`
+    (``share``); and the simulations run."""
 
     child: Any
     h: float | None
-    staged: tuple[Any, ...] | None
+    batch: Any
     simulations: int
-
-    @property
-    def partial(self) -> bool:
-        return self.staged is not None
 
 
 def _work(context: Any, job: tuple[Any, ...]) -> _Answer:
-    """Worker side: one job of :class:`_Child` (``whole``, ``first`` or ``rest``)."""
-    kind, belief, action, with_h, first = job
+    """Worker side: one job of :class:`_Child`: ``("whole", belief, action, with_h)`` or
+    ``("share", belief, action, indices, affected)``."""
     with context.lock():
         task = context.task()
         semantics = task.semantics
         before = semantics.simulations
-        staged: tuple[Any, ...] | None = None
-        if kind == "whole":
+        if job[0] == "whole":
+            _, belief, action, with_h = job
             child = semantics.apply(belief, action)
-        elif kind == "first":
-            affected = semantics.affected_objects(belief.intervals, action)
-            indices = first_share(belief, affected) if affected else ()
-            if not indices:  # reaches nothing, or nothing to gain: the whole push at once
-                child = semantics.apply(belief, action)
-            else:
-                batch, _ = semantics.push_share(belief, action, indices, affected)
-                child = None
-                if batch.ok:
-                    # every particle outside the share stands in with the share's first
-                    # particle's pushed objects: the box of this belief is the share's for the
-                    # pushed objects and the full child's, exactly, for the others
-                    outcomes = dict(zip(indices, batch.outcomes, strict=True))
-                    stand_in = batch.outcomes[0]
-                    full = [outcomes.get(i, stand_in) for i in range(belief.poses.shape[0])]
-                    child = semantics.moved_particles(belief, full)
-                    staged = (indices, batch.outcomes, affected)
-        else:
-            indices, outcomes, affected = first
-            chosen = set(indices)
-            rest = [i for i in range(belief.poses.shape[0]) if i not in chosen]
-            batch, _ = semantics.push_share(belief, action, rest, affected)
-            child = None
-            if batch.ok:
-                every = dict(zip(indices, outcomes, strict=True))
-                every.update(zip(rest, batch.outcomes, strict=True))
-                child = semantics.moved_particles(belief, [every[i] for i in sorted(every)])
-        h = None
-        if with_h and child is not None and staged is None:
-            h = float(task.heuristic(child))
-        return _Answer(child, h, staged, semantics.simulations - before)
+            h = float(task.heuristic(child)) if with_h and child is not None else None
+            return _Answer(child, h, None, semantics.simulations - before)
+        _, belief, action, indices, affected = job
+        batch, _ = semantics.push_share(belief, action, indices, affected)
+        return _Answer(None, None, batch, semantics.simulations - before)
 
 
 class _Child:
-    """``make_child`` of one edge: computes the child through the evaluator's session, in one
-    job or two staged ones, and answers the search with it, None or :data:`DOMINATED`."""
+    """``make_child`` of one edge: computes the child through the evaluator's sessions and
+    answers the search with it, None (no prediction) or :data:`DOMINATED`.
 
-    __slots__ = ("action", "belief", "done", "evaluator", "first", "pending", "stage")
+    A push of a particle semantics that reaches something, with a small enough
+    :func:`first_share`, is staged: two ``share`` jobs, the first share and the rest, sent
+    together (a serial session computes the rest only if asked; workers compute both side by
+    side); when the search asks, the first share's box is tested, and the rest is read only
+    if it is not dominated. Anything else is one ``whole`` job: on the runner for a push, here
+    for a place or a pick (they cost less than a round trip).
+    """
+
+    __slots__ = ("action", "belief", "done", "evaluator", "jobs", "shares")
 
     def __init__(self, evaluator: SuccessorEvaluator, belief: Any, action: Any) -> None:
         self.evaluator, self.belief, self.action = evaluator, belief, action
-        self.stage = 0  # 0 nothing sent, 1 first share (or whole) sent, 2 rest sent
-        self.pending: Pending[_Answer] | None = None
-        self.first: _Answer | None = None
+        self.jobs: list[Pending[_Answer]] = []
+        self.shares: tuple[tuple[int, ...], tuple[int, ...], frozenset[str]] | None = None
         self.done = False
 
-    def staged(self) -> bool:
-        return self.evaluator.staged and isinstance(self.action, Push)
+    def sent(self) -> bool:
+        return bool(self.jobs)
 
-    def send(self) -> None:
-        """Send the next job of this edge (a no-op once it is sent)."""
+    def send(self, here: bool = False) -> None:
+        """Send this edge's jobs (a no-op once sent): pushes to the runner, unless ``here``."""
+        if self.jobs:
+            return
         ev = self.evaluator
-        remote = ev.ahead and isinstance(self.action, Push)
-        if self.stage == 0:
-            kind = "first" if self.staged() else "whole"
-            self.pending = ev.send((kind, self.belief, self.action, remote, None), remote)
-            self.stage = 1
-        elif self.stage == 1 and self.first is not None and self.first.partial:
-            job = ("rest", self.belief, self.action, remote, self.first.staged)
-            self.pending = ev.send(job, remote)
-            self.stage = 2
+        if not isinstance(self.action, Push):
+            self.jobs = [ev.here.submit(("whole", self.belief, self.action, False))]
+            return
+        remote = ev.here if here else ev.session
+        if ev.staged:
+            semantics = ev.task.semantics
+            affected = semantics.affected_objects(self.belief.intervals, self.action)
+            first = first_share(self.belief, affected) if affected else ()
+            if first:
+                chosen = set(first)
+                rest = tuple(i for i in range(len(self.belief.poses)) if i not in chosen)
+                self.shares = (first, rest, affected)
+                self.jobs = [
+                    remote.submit(("share", self.belief, self.action, part, affected))
+                    for part in (first, rest)
+                ]
+                ev.sent += 2
+                return
+        self.jobs = [remote.submit(("whole", self.belief, self.action, ev.ahead and not here))]
+        ev.sent += 1
 
-    def advance(self) -> None:
-        """Ahead of the search: take a finished answer; a first share whose belief is not
-        dominated *now* sends the rest (one dominated now is dominated when the search asks:
-        the index only grows)."""
-        if self.pending is not None and self.first is None and self.pending.done():
-            answer = self._take()
-            if answer.partial and not self.evaluator.dominated(answer.child):
-                self.send()
-
-    def _take(self) -> _Answer:
-        """Wait for the job sent last; its answer is kept in ``first`` until the search asks."""
-        assert self.pending is not None
-        answer = self.pending.result()
-        self.pending = None
-        self.first = answer
-        return answer
+    def reset(self) -> None:
+        """Forget the jobs (cancelled if not started): sent again if the search asks."""
+        for job in self.jobs:
+            job.cancel()
+        self.jobs, self.shares = [], None
 
     def __call__(self) -> Any:
         ev = self.evaluator
+        if self.jobs and not all(job.done() for job in self.jobs):
+            # asked for before the workers started on it: this process computes it rather
+            # than wait for it in the queue behind work sent ahead
+            if all(job.cancel() for job in self.jobs if not job.done()):
+                self.jobs, self.shares = [], None
+        # not sent ahead: computed here, as with one worker, not queued behind work sent ahead
+        self.send(here=True)
         self.done = True
-        if self.stage == 0:
-            self.send()
-        answer = self.first if self.first is not None else self._take()
-        ev.simulations += answer.simulations
-        if answer.partial:
-            # the test runs now, against the index as the search has it now (module doc)
-            if ev.dominated(answer.child):
-                if self.pending is not None:  # the rest, sent ahead, is not needed
-                    self.pending.cancel()
-                self._release()
-                return DOMINATED
-            self.send()  # the rest, unless it was sent ahead
-            self.first = None
-            answer = self._take()
-            ev.simulations += answer.simulations
-        self._release()
-        ev.last = (answer.child, answer.h)
-        return answer.child
-
-    def _release(self) -> None:
-        self.first = None
-        self.pending = None
+        jobs, self.jobs = self.jobs, []
+        first = jobs[0].result()
+        ev.simulations += first.simulations
+        if self.shares is None:
+            ev.last = (first.child, first.h)
+            return first.child
+        indices, rest, affected = self.shares
+        self.shares = None
+        semantics = ev.task.semantics
+        if not first.batch.ok:
+            jobs[1].cancel()
+            return None
+        outcomes = dict(zip(indices, first.batch.outcomes, strict=True))
+        # the particles outside the share stand in with the share's first particle's pushed
+        # objects: this belief's box is the share's for those objects and, exactly, the full
+        # child's for the others (canonical angles are wrapped object by object)
+        stand_in = first.batch.outcomes[0]
+        box = semantics.moved_particles(
+            self.belief, [outcomes.get(i, stand_in) for i in range(len(self.belief.poses))]
+        )
+        # the test runs now, against the index as the search has it now (module doc)
+        if ev.dominated(box):
+            jobs[1].cancel()
+            return DOMINATED
+        second = jobs[1].result()
+        ev.simulations += second.simulations
+        if not second.batch.ok:
+            return None
+        outcomes.update(zip(rest, second.batch.outcomes, strict=True))
+        return semantics.moved_particles(self.belief, [outcomes[i] for i in sorted(outcomes)])
 
 
 class SuccessorEvaluator:
@@ -286,7 +281,8 @@ class SuccessorEvaluator:
             and isinstance(task.semantics, ParticleSemantics)
             and task.semantics.particles > 2
         )
-        self.ahead = runner.workers > 1
+        # a Dask cluster of one worker is still another machine's core to use
+        self.ahead = runner.workers > 1 or runner.backend == "dask"
         here = _InProcess(task)
         # places and picks are computed here, pushes (the physics) on the runner
         self.here: Session[tuple[Any, ...], _Answer] = SerialRunner().session(_work, here)
@@ -311,46 +307,35 @@ class SuccessorEvaluator:
         return self.task.heuristic(belief)
 
     def prefetch(self, edges: Sequence[Edge[Any, Any]]) -> None:
-        """Send the children of ``edges`` (the next the search will evaluate, in order) to the
-        workers while they have room; no-op with one worker."""
-        if not self.ahead:
-            return
-        for child in list(self._sent):
-            child.advance()
+        """Send the pushes among ``edges`` (the next the search will evaluate, in order) to
+        the workers while they have room; places and picks are left to be computed here."""
         room = AHEAD_PER_WORKER * self.runner.workers
-        self._sent = deque(c for c in self._sent if not c.done and c.pending is not None)
-        busy = sum(1 for c in self._sent if not c.pending.done())  # type: ignore[union-attr]
+        self._sent = deque(c for c in self._sent if not c.done)
+        busy = sum(not job.done() for c in self._sent for job in c.jobs)
         for edge in edges:
             child = edge.make_child
-            if not isinstance(child, _Child) or child.done or child.stage:
-                continue
-            if not isinstance(child.action, Push):
-                continue  # places and picks cost less than a round trip: done here when asked
             if busy >= room:
                 break
+            if not isinstance(child, _Child) or child.done or child.sent():
+                continue
+            if not isinstance(child.action, Push):
+                continue
             child.send()
-            busy += 1
+            busy += len(child.jobs)
             self._sent.append(child)
             self._ahead.append(child)
         while len(self._ahead) > KEPT_AHEAD:
             dropped = self._ahead.popleft()
             if not dropped.done:
-                if dropped.pending is not None:
-                    dropped.pending.cancel()
-                dropped.stage, dropped.pending, dropped.first = 0, None, None
+                dropped.reset()
 
     # -- helpers ---------------------------------------------------------------------------------
-    def send(self, job: tuple[Any, ...], remote: bool) -> Pending[_Answer]:
-        self.sent += 1
-        return (self.session if remote else self.here).submit(job)
-
     def dominated(self, partial: ParticleBelief) -> bool:
         assert self.index is not None
         return self.index.dominated(partial, 0.0)
 
     def close(self) -> None:
         for child in self._sent:
-            if child.pending is not None:
-                child.pending.cancel()
+            child.reset()
         if self.session is not self.here:
             self.session.close()
