@@ -24,8 +24,9 @@ Backends
   (at most two tasks per worker in flight) and read with ``concurrent.futures.wait``. loky keeps
   one executor per process and hands the same one to every caller that asks with the same
   arguments, so only the first batch pays the pool's start-up (the workers' imports dominate
-  it); the particle semantics (and through it the fixture repair) and the rollouts share it; it
-  is the process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
+  it); the particle semantics (and through it the fixture repair), the planner's successor
+  sessions (:mod:`arrange_up.planning.successors`) and the rollouts share it; it is the
+  process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
   seconds and respawned by the next batch. Each worker watches its parent
   (:func:`_end_with_parent`) and ends within :data:`PARENT_POLL` seconds of the parent's
   death, even a SIGKILL that gives the parent no chance to stop its pool. Interrupting a

@@ -6,29 +6,35 @@ successor belief to compute next; :class:`SuccessorEvaluator` computes them.
 Staged pushes (less wasted simulation)
 --------------------------------------
 Dominance (:class:`~arrange_up.belief.states.IntervalDominanceIndex`) prunes a belief when a
-stored belief's box lies inside its own. The box of a few particles lies inside the box of
-all of them, so if the belief of the first :func:`first_share` particles after a push is
-already dominated, the whole child is too, and its other particles need not be simulated.
-A push child is therefore computed in two shares: the first particles, the dominance test on
-their belief, then (unless dominated) the rest. The test runs at the moment the search
-evaluates the edge, against the index as the search has it then, so the search discards
-exactly the children it would have discarded anyway: plans are unchanged (the search counts
-the child as ``pruned_dominated``, where a full simulation might have found it a duplicate or
-refused it, discarded just the same).
+stored belief's box lies inside its own. The box of some of a child's particles lies inside
+the box of all of them, so if a belief of some particles after a push is already dominated,
+the whole child is too, and its other particles need not be simulated. A push is therefore
+computed in two shares: first the particles at the least or greatest value of some pose
+coordinate of a pushed object in the *parent* (:func:`first_share`: the particles likeliest
+to span the child's box; a dominated child's box is usually within the tolerance of its
+dominator's, so a share of arbitrary particles rarely shows it), then the dominance test,
+then, unless dominated, the rest. The test runs when the search evaluates the edge, against
+the index as the search has it then, so the search discards exactly the children it would
+have discarded anyway: plans are unchanged (the child counts as ``pruned_dominated``, where a
+full simulation might have found it a duplicate or refused it, discarded just the same), and
+``transitions_simulated`` counts the particles simulated.
 
 Parallel successors
 -------------------
-With a runner of more than one worker (:func:`arrange_up.parallel.get_runner`: local loky
-processes or a Dask cluster), the search hands the evaluator the edges it will evaluate next
-(:meth:`SuccessorEvaluator.prefetch`) and the workers compute those children, with their
-heuristic values, while the search deals with the current one. A child is a function of the
-parent belief, the action and the run's seed only (see :mod:`arrange_up.transitions.particles`),
-so which worker computes it, and whether it was computed ahead, changes nothing: the search
-makes the same decisions in the same order, and plans and statistics are identical for any
-worker count and backend. The problem, and the task each worker builds from it, travel to
-each worker once (a :class:`~arrange_up.parallel.Session`); a task carries a belief and an
-action. Work computed ahead that the search never asks for is wasted (it is not in the run's
-statistics; :attr:`SuccessorEvaluator.sent` counts the jobs sent).
+With a runner of more than one worker, or a Dask one (:func:`arrange_up.parallel.get_runner`),
+the search tells the evaluator which edges it will evaluate next
+(:meth:`SuccessorEvaluator.prefetch`) and the workers simulate the pushes among them (with
+the heuristic value of a push simulated whole; a staged push's two shares run side by side)
+while the search deals with the current edge. Places and picks cost less than a round trip
+and are computed here when asked for, as is a push asked for before a worker started on it
+(rather than queued behind work sent ahead); at most one job per worker is in flight. A child
+is a function of the parent belief, the action and the run's seed only (see
+:mod:`arrange_up.transitions.particles`), so which process computes it, and whether it was
+computed ahead, changes nothing: the search makes the same decisions in the same order, and
+plans and statistics are identical for any worker count and backend. The problem, and the task
+each worker builds from it, travel to each worker once (a :class:`~arrange_up.parallel.Session`);
+a job carries a belief and an action. Pushes computed ahead that the search never asks for are
+wasted work (not in the run's statistics; :attr:`SuccessorEvaluator.sent` counts the jobs).
 """
 
 from __future__ import annotations
