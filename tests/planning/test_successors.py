@@ -18,6 +18,7 @@ from arrange_up.model.world import WorldState
 from arrange_up.parallel import get_runner
 from arrange_up.planning import successors
 from arrange_up.planning.planner import plan
+from tests.test_parallel import _die_once
 
 
 def _outcome(result) -> tuple:
@@ -101,16 +102,9 @@ def test_a_session_ships_its_context_to_each_worker_once():
     assert all(len(ids) == 1 for ids in contexts.values())  # unpickled once per worker
 
 
-def _die_once(marker: str, item: int) -> int:
-    if not os.path.exists(marker):
-        open(marker, "w").close()
-        os._exit(1)  # the worker is lost with its task
-    return item + 1
-
-
 def test_a_task_lost_with_its_worker_is_sent_again(tmp_path):
     runner = get_runner("local", workers=2)
-    session = runner.session(_die_once, str(tmp_path / "died"))
+    session = runner.session(_die_once, str(tmp_path / "died"))  # the worker dies once
     assert session.submit(41).result() == 42
     assert (tmp_path / "died").exists()
 
