@@ -13,7 +13,8 @@ with ``git archive``; the baseline runs each config as its code understands it (
 only: its ``plan`` knows no backend, so dask configs are not run for it). Old and new runs of a
 case alternate, repeat by repeat and in alternating order, so a pair shares the machine's load.
 
-Each run prints one row: wall seconds of the ``plan`` call, nodes expanded, transitions
+Each run prints one row: wall seconds of the ``plan`` call (for dask, after the LocalCluster
+was started, which ``startup_s`` gives), nodes expanded, transitions
 evaluated, simulations (``transitions_simulated``), simulations per second, the process's peak
 resident memory (MB; worker processes not included) and the plan length; and whether its plan
 equals the first run's of the case (``same``). The summary gives, per case and config, the
@@ -47,6 +48,7 @@ FIELDS = [
     "repeat",
     "status",
     "seconds",
+    "startup_s",
     "expanded",
     "evaluated",
     "simulations",
@@ -72,6 +74,15 @@ def child(problem_name: str, particles: int, seed: int, config: str) -> None:
     else:
         options.update(particles=particles)
     problem = arrange_up.load(problem_name)
+    startup = 0.0
+    if backend != "local":
+        # the cluster is started (and cached) first: "seconds" is the planning on it, as
+        # with --scheduler, and "startup_s" what starting a LocalCluster adds to a command
+        from arrange_up.parallel import get_runner
+
+        begin = time.perf_counter()
+        get_runner(backend, int(workers))
+        startup = time.perf_counter() - begin
     start = time.perf_counter()
     result = plan(problem, seed=seed, **options)
     seconds = time.perf_counter() - start
@@ -82,6 +93,7 @@ def child(problem_name: str, particles: int, seed: int, config: str) -> None:
             {
                 "status": str(result.status),
                 "seconds": round(seconds, 3),
+                "startup_s": round(startup, 3),
                 "expanded": stats["expanded"],
                 "evaluated": stats["evaluated"],
                 "simulations": stats["transitions_simulated"],
