@@ -69,7 +69,7 @@ KEPT_AHEAD = 2048
 def first_share(belief: ParticleBelief, affected: frozenset[str]) -> tuple[int, ...]:
     """The particles simulated first in a staged push of ``belief`` moving ``affected``: those
     at the least or the greatest value of some pose coordinate of an affected object, in
-    coordinate order (the particles likeliest to span the child's box), or none (no staging)
+    particle order (the particles likeliest to span the child's box), or none (no staging)
     when they are more than :data:`FIRST_SHARE` of the particles."""
     names = belief.names()
     columns = [j for j, name in enumerate(names) if name in affected]
@@ -96,8 +96,14 @@ class WorkerSpec:
     _task: BeliefTask | None = field(default=None, repr=False)
     _lock: Any = field(default=None, repr=False)
 
+    def __post_init__(self) -> None:
+        self._lock = threading.Lock()
+
     def __getstate__(self) -> dict[str, Any]:
         return {**self.__dict__, "_task": None, "_lock": None}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state, _lock=threading.Lock())
 
     def task(self) -> BeliefTask:
         if self._task is None:
@@ -116,8 +122,6 @@ class WorkerSpec:
 
     def lock(self) -> Any:
         # a threaded Dask worker runs tasks side by side in one process: one at a time here
-        if self._lock is None:
-            self._lock = threading.Lock()
         return self._lock
 
 
