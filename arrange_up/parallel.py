@@ -52,6 +52,7 @@ needs each answer on demand, so :meth:`Runner.session` opens a :class:`Session` 
     session = runner.session(fn, context)     # fn(context, item) -> result, module-level
     pending = session.submit(item)            # starts the work (SerialRunner: on result())
     result = pending.result()                 # waits; the same value for any backend
+    pending.withdraw()                        # True: dropped before it started (local only)
 
 ``context`` (the problem and what the worker builds from it) is shipped to each worker once,
 not with every task: Dask scatters it to every worker (``broadcast=True``); a local worker
@@ -173,9 +174,12 @@ class Pending(Generic[R]):
         """True when :meth:`result` would not wait."""
         return True
 
-    def cancel(self) -> bool:
-        """Drop the task if it has not started (its result is not wanted): True when it will
-        not run (it was still queued), False when it may have run or be running."""
+    def cancel(self) -> None:
+        """Drop the task (its result is not wanted): it does not run if it has not started."""
+
+    def withdraw(self) -> bool:
+        """Drop the task only if it surely has not started: True when it was dropped (the
+        caller computes the result itself), False when it goes on (:meth:`result` waits)."""
         return False
 
 
@@ -389,8 +393,11 @@ class _LocalPending(Pending[R]):
                 continue
             return value
 
-    def cancel(self) -> bool:
-        return bool(self.future.cancel())
+    def cancel(self) -> None:
+        self.future.cancel()
+
+    def withdraw(self) -> bool:
+        return bool(self.future.cancel())  # False once a worker has it
 
 
 class _LocalSession(Session[T, R]):
@@ -509,9 +516,8 @@ class _DaskPending(Pending[R]):
                 self.session.rescatter()
                 self.future = self.session.send(self.item)
 
-    def cancel(self) -> bool:
+    def cancel(self) -> None:
         self.future.cancel()
-        return False  # the scheduler may have started it already: nobody can tell from here
 
 
 class _DaskSession(Session[T, R]):

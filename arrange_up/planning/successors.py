@@ -225,12 +225,13 @@ class _Child:
 
     def __call__(self) -> Any:
         ev = self.evaluator
-        if self.jobs and not all(job.done() for job in self.jobs):
-            # asked for before the workers started on it: this process computes it rather
-            # than wait for it in the queue behind work sent ahead
-            if all(job.cancel() for job in self.jobs if not job.done()):
-                self.jobs, self.shares = [], None
-        # not sent ahead: computed here, as with one worker, not queued behind work sent ahead
+        if self.jobs and not any(job.done() for job in self.jobs) and self.jobs[0].withdraw():
+            # asked for before a worker took it: this process computes it rather than wait
+            # for it behind work sent ahead (a later job taken meanwhile is just wasted)
+            for job in self.jobs[1:]:
+                job.cancel()
+            self.jobs, self.shares = [], None
+        # not sent ahead (or withdrawn): computed here, as with one worker
         self.send(here=True)
         self.done = True
         jobs, self.jobs = self.jobs, []
