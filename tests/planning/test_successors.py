@@ -115,3 +115,17 @@ def test_serial_sessions_compute_only_what_is_asked_for():
     pending = [session.submit(i) for i in range(3)]
     assert calls == [] and not pending[1].done()
     assert pending[1].result() == 1 and calls == [1]
+
+
+def test_a_belief_from_another_process_hashes_as_one_made_here():
+    # Python salts string hashes per process: a belief a worker sent back must hash anew, or
+    # duplicate detection would never find it
+    belief = _belief(4)
+    runner = get_runner("local", workers=2)
+    made_there = runner.session(_make_belief, None).submit(4).result()
+    assert made_there == belief and hash(made_there) == hash(belief)
+    assert {made_there} == {belief} and not made_there.poses.flags.writeable
+
+
+def _make_belief(context: object, particles: int) -> ParticleBelief:
+    return _belief(particles)
