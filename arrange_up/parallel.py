@@ -24,8 +24,9 @@ Backends
   (at most two tasks per worker in flight) and read with ``concurrent.futures.wait``. loky keeps
   one executor per process and hands the same one to every caller that asks with the same
   arguments, so only the first batch pays the pool's start-up (the workers' imports dominate
-  it); the particle semantics (and through it the fixture repair) and the rollouts share it; it
-  is the process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
+  it); the particle semantics (and through it the fixture repair), the planner's successor
+  sessions (:mod:`arrange_up.planning.successors`) and the rollouts share it; it is the
+  process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
   seconds and respawned by the next batch. Each worker watches its parent
   (:func:`_end_with_parent`) and ends within :data:`PARENT_POLL` seconds of the parent's
   death, even a SIGKILL that gives the parent no chance to stop its pool. Interrupting a
@@ -43,6 +44,24 @@ Backends
   imported only here, and only when this backend is asked for; without it
   :class:`BackendUnavailableError` says to ``pip install "arrange-up[dask]"``.
 
+Sessions
+========
+``map`` suits a batch known in advance. A search learns its work one step at a time and
+needs each answer on demand, so :meth:`Runner.session` opens a :class:`Session` instead::
+
+    session = runner.session(fn, context)     # fn(context, item) -> result, module-level
+    pending = session.submit(item)            # starts the work (SerialRunner: on result())
+    result = pending.result()                 # waits; the same value for any backend
+    pending.withdraw()                        # True: dropped before it started (local only)
+
+``context`` (the problem and what the worker builds from it) is shipped to each worker once,
+not with every task: Dask scatters it to every worker (``broadcast=True``); a local worker
+keeps the contexts it has unpickled, by digest, and a task that meets a worker without it is
+sent again with the pickle (so a worker respawned after :data:`IDLE_TIMEOUT` gets it again).
+A task lost with its worker (a crashed loky process, a Dask worker gone, its data lost) is
+submitted again, up to :data:`RETRIES` times; since results depend on ``(context, item)``
+only, a retried task gives the result the first attempt would have.
+
 :func:`get_runner` caches runners, so repeated batches in one process reuse the same pool or
 cluster; :func:`shutdown` closes the cached Dask clients and clusters (the local pool is
 joblib's and reaps itself).
@@ -51,23 +70,28 @@ joblib's and reaps itself).
 from __future__ import annotations
 
 import atexit
+import hashlib
 import logging
 import math
 import os
+import pickle
 import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, wait
 from itertools import islice
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar
 
 __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
     "DaskRunner",
     "LocalRunner",
+    "Pending",
     "Runner",
     "SerialRunner",
+    "Session",
     "available_cores",
     "get_runner",
     "local_executor",
@@ -118,6 +142,11 @@ class Runner:
     ) -> Iterator[tuple[T, R]]:  # pragma: no cover - abstract
         raise NotImplementedError
 
+    def session(self, fn: Callable[[Any, T], R], context: Any) -> Session[T, R]:
+        """A :class:`Session` running ``fn(context, item)`` per submitted item, with
+        ``context`` shipped to each worker once (see the module doc)."""
+        raise NotImplementedError  # pragma: no cover - abstract
+
     def close(self) -> None:
         """Release what this runner holds (nothing by default)."""
 
@@ -129,6 +158,65 @@ def _check_chunksize(chunksize: int) -> int:
     if not isinstance(chunksize, int) or isinstance(chunksize, bool) or chunksize < 1:
         raise ValueError(f"chunksize must be a positive integer, got {chunksize!r}")
     return chunksize
+
+
+#: Times a task lost with its worker (not one whose function raised) is submitted again.
+RETRIES = 2
+
+
+class Pending(Generic[R]):
+    """The answer of one :meth:`Session.submit`: :meth:`result` waits for it."""
+
+    def result(self) -> R:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def done(self) -> bool:
+        """True when :meth:`result` would not wait."""
+        return True
+
+    def cancel(self) -> None:
+        """Drop the task (its result is not wanted): it does not run if it has not started."""
+
+    def withdraw(self) -> bool:
+        """Drop the task only if it surely has not started: True when it was dropped (the
+        caller computes the result itself), False when it goes on (:meth:`result` waits)."""
+        return False
+
+
+class Session(Generic[T, R]):
+    """``fn(context, item)`` for items submitted one at a time (see the module doc)."""
+
+    def submit(self, item: T) -> Pending[R]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Release the context on the workers (nothing by default)."""
+
+
+class _Lazy(Pending[R]):
+    """Computed here, when first asked for: a serial session does no work nobody reads."""
+
+    def __init__(self, fn: Callable[[Any, Any], R], context: Any, item: Any) -> None:
+        self._call: tuple[Any, Any, Any] | None = (fn, context, item)
+        self._value: Any = None
+
+    def result(self) -> R:
+        if self._call is not None:
+            fn, context, item = self._call
+            self._value = fn(context, item)
+            self._call = None
+        return self._value
+
+    def done(self) -> bool:
+        return self._call is None
+
+
+class _SerialSession(Session[T, R]):
+    def __init__(self, fn: Callable[[Any, T], R], context: Any) -> None:
+        self.fn, self.context = fn, context
+
+    def submit(self, item: T) -> Pending[R]:
+        return _Lazy(self.fn, self.context, item)
 
 
 class SerialRunner(Runner):
@@ -143,6 +231,9 @@ class SerialRunner(Runner):
         _check_chunksize(chunksize)
         for item in items:
             yield item, fn(item)
+
+    def session(self, fn: Callable[[Any, T], R], context: Any) -> Session[T, R]:
+        return _SerialSession(fn, context)
 
 
 #: Idle seconds after which loky reaps a pool's workers. It is loky's default on purpose: loky
@@ -235,6 +326,94 @@ class LocalRunner(Runner):
             for future in pending:
                 future.cancel()
 
+    def session(self, fn: Callable[[Any, T], R], context: Any) -> Session[T, R]:
+        return _LocalSession(self.workers, fn, context)
+
+
+#: Worker side of a local session: the contexts this worker has unpickled, by digest, most
+#: recently used last (a few, for the runs of one process that share the pool).
+_CONTEXTS: OrderedDict[bytes, Any] = OrderedDict()
+_CONTEXTS_KEPT = 4
+
+
+class _ContextMissing:
+    """A worker's answer to a task whose context it does not have (sent again with it)."""
+
+
+def _call_in_context(
+    fn: Callable[[Any, Any], Any], digest: bytes, payload: bytes | None, item: Any
+) -> Any:
+    """Worker side: ``fn(context, item)`` with the context of ``digest``, unpickled from
+    ``payload`` the first time this worker sees it."""
+    context = _CONTEXTS.get(digest)
+    if context is None:
+        if payload is None:
+            return _ContextMissing()
+        context = _CONTEXTS[digest] = pickle.loads(payload)
+        while len(_CONTEXTS) > _CONTEXTS_KEPT:
+            _CONTEXTS.popitem(last=False)
+    else:
+        _CONTEXTS.move_to_end(digest)
+    return fn(context, item)
+
+
+class _LocalPending(Pending[R]):
+    def __init__(self, session: _LocalSession[Any, R], item: Any) -> None:
+        self.session, self.item = session, item
+        self.attempts = 0
+        self.future = session.send(item, with_context=False)
+
+    def _retry(self, with_context: bool) -> None:
+        self.future = self.session.send(self.item, with_context=with_context)
+
+    def done(self) -> bool:
+        if not self.future.done():
+            return False
+        # a worker without the context answered: send again with it, then it is not done
+        if not self.future.cancelled() and self.future.exception() is None:
+            if isinstance(self.future.result(), _ContextMissing):
+                self._retry(with_context=True)
+                return False
+        return True
+
+    def result(self) -> R:
+        from concurrent.futures.process import BrokenProcessPool
+
+        while True:
+            try:
+                value = self.future.result()
+            except BrokenProcessPool:  # a worker died (killed, out of memory): the pool is
+                self.attempts += 1  # rebuilt by the next local_executor call
+                if self.attempts > RETRIES:
+                    raise
+                self._retry(with_context=True)
+                continue
+            if isinstance(value, _ContextMissing):
+                self._retry(with_context=True)
+                continue
+            return value
+
+    def cancel(self) -> None:
+        self.future.cancel()
+
+    def withdraw(self) -> bool:
+        return bool(self.future.cancel())  # False once a worker has it
+
+
+class _LocalSession(Session[T, R]):
+    def __init__(self, workers: int, fn: Callable[[Any, T], R], context: Any) -> None:
+        self.workers, self.fn = workers, fn
+        self.payload = pickle.dumps(context, protocol=pickle.HIGHEST_PROTOCOL)
+        self.digest = hashlib.blake2b(self.payload, digest_size=16).digest()
+
+    def send(self, item: T, *, with_context: bool) -> Any:
+        payload = self.payload if with_context else None
+        executor = local_executor(self.workers)
+        return executor.submit(_call_in_context, self.fn, self.digest, payload, item)
+
+    def submit(self, item: T) -> Pending[R]:
+        return _LocalPending(self, item)
+
 
 class DaskRunner(Runner):
     """A ``dask.distributed`` client: a LocalCluster of its own, or an existing scheduler."""
@@ -301,6 +480,9 @@ class DaskRunner(Runner):
             if in_flight:  # interrupted: drop what is queued, keep the cluster
                 client.cancel(list(in_flight))
 
+    def session(self, fn: Callable[[Any, T], R], context: Any) -> Session[T, R]:
+        return _DaskSession(self.client, fn, context)
+
     def close(self) -> None:
         self.client.close()
         if self._cluster is not None:
@@ -309,6 +491,61 @@ class DaskRunner(Runner):
     def describe(self) -> str:
         where = self.scheduler or "LocalCluster"
         return f"dask ({where}), {self.workers} worker{'s' if self.workers != 1 else ''}"
+
+
+class _DaskPending(Pending[R]):
+    def __init__(self, session: _DaskSession[Any, R], item: Any) -> None:
+        self.session, self.item = session, item
+        self.attempts = 0
+        self.future = session.send(item)
+
+    def done(self) -> bool:
+        return bool(self.future.done())
+
+    def result(self) -> R:
+        while True:
+            try:
+                return self.future.result()
+            except Exception as error:
+                # A worker lost with the task or its context (KilledWorker, a cancelled or
+                # lost dependency): send again, re-scattering the context if need be. An
+                # exception of fn itself is raised on the first attempt.
+                if not self.session.lost(error) or self.attempts >= RETRIES:
+                    raise
+                self.attempts += 1
+                self.session.rescatter()
+                self.future = self.session.send(self.item)
+
+    def cancel(self) -> None:
+        self.future.cancel()
+
+
+class _DaskSession(Session[T, R]):
+    def __init__(self, client: Any, fn: Callable[[Any, T], R], context: Any) -> None:
+        self.client, self.fn, self.context = client, fn, context
+        self.rescatter()
+
+    def rescatter(self) -> None:
+        # every worker gets the context once (docs/design/planning.md, parallel planning)
+        self.context_future = self.client.scatter(self.context, broadcast=True, hash=False)
+
+    def send(self, item: T) -> Any:
+        return self.client.submit(self.fn, self.context_future, item, pure=False)
+
+    @staticmethod
+    def lost(error: BaseException) -> bool:
+        from distributed import KilledWorker
+        from distributed.client import FutureCancelledError
+
+        return isinstance(error, (KilledWorker, FutureCancelledError, OSError)) or (
+            type(error).__name__ in {"CancelledError", "FutureCancelledError"}
+        )
+
+    def submit(self, item: T) -> Pending[R]:
+        return _DaskPending(self, item)
+
+    def close(self) -> None:
+        self.context_future.release()
 
 
 def _import_distributed() -> Any:

@@ -74,6 +74,7 @@ from typing import Any, Generic, Protocol, TypeVar
 
 __all__ = [
     "DEAD_END_CACHE",
+    "DOMINATED",
     "PROGRESS_INTERVAL",
     "Edge",
     "SearchResult",
@@ -138,6 +139,19 @@ class DominanceIndex(Protocol):
         ...
 
 
+class _Dominated:
+    """The type of :data:`DOMINATED` (one instance; it survives no pickling, nor needs to)."""
+
+    def __repr__(self) -> str:
+        return "DOMINATED"
+
+
+#: What ``make_child`` returns when it has shown, before computing the whole child, that the
+#: search's dominance test would prune it (a staged evaluation; see
+#: :mod:`arrange_up.planning.successors`). The search counts it as ``pruned_dominated``.
+DOMINATED: Any = _Dominated()
+
+
 def _constant(value: Any) -> Callable[[], Any]:
     # A named factory rather than an inline lambda so each Edge gets its own closure over `value`.
     return lambda: value
@@ -155,8 +169,10 @@ class Edge(Generic[S, A]):
         Finite, non-negative cost of the transition.
     make_child
         Computes the child state, or returns ``None`` when the transition has no prediction or is
-        invalid. Called at most once per edge by the search (at generation in eager mode, when
-        the edge is popped in deferred mode, or never if the edge is left in the open list).
+        invalid, or :data:`DOMINATED` when it has shown that the child would be pruned as
+        dominated (it may consult the search's ``dominance_index`` to do so). Called at most
+        once per edge by the search (at generation in eager mode, when the edge is popped in
+        deferred mode, or never if the edge is left in the open list).
     """
 
     action: A
@@ -185,7 +201,8 @@ class SearchStats:
         the middle of an expansion); in deferred mode the edges still queued at the end are
         never evaluated.
     pruned_dominated
-        Children discarded because an accepted state of the same dominance key dominates them.
+        Children discarded because an accepted state of the same dominance key dominates them
+        (including those ``make_child`` found dominated, :data:`DOMINATED`).
     pruned_infinite
         States discarded because the heuristic returned ``math.inf`` (including the start).
     pruned_duplicate
@@ -286,6 +303,8 @@ class _Search:
         progress: Callable[[SearchStats], None] | None,
         should_stop: Callable[[], bool] | None,
         clock: Callable[[], float],
+        prefetch: Callable[[list[Edge[Any, Any]]], None] | None = None,
+        prefetch_depth: int = 0,
     ) -> None:
         self.successors = successors
         self.is_goal = is_goal
@@ -303,6 +322,8 @@ class _Search:
         self.progress = progress
         self.should_stop = should_stop
         self.clock = clock
+        self.prefetch = prefetch
+        self.prefetch_depth = prefetch_depth
         self.rng = random.Random(tie_break_seed) if tie_break_seed is not None else None
 
         self.stats = SearchStats()
@@ -403,11 +424,28 @@ class _Search:
         if child is None:
             self.stats.no_prediction += 1
             return None
+        if child is DOMINATED:
+            self.stats.pruned_dominated += 1
+            return None
         g = parent.g + edge.cost
         h = self.accept(child, g)
         if h is None:
             return None
         return _Node(child, g, h, parent, edge.action)
+
+    def upcoming(self) -> list[Edge[Any, Any]]:
+        """The edges of the next ``prefetch_depth`` open entries, in the order they will be
+        popped unless an expansion queues better ones (stale entries left out). The k-th
+        smallest entry of a heap lies in its first k levels, so those are all it reads."""
+        depth = self.prefetch_depth
+        entries = heapq.nsmallest(depth, self.open[: 2**depth - 1])
+        edges = []
+        for *_, payload in entries:
+            if isinstance(payload, tuple):
+                parent, edge = payload
+                if parent.g <= self.g_best[parent.state]:
+                    edges.append(edge)
+        return edges
 
     # -- stopping ----------------------------------------------------------------------------------
     def interrupted(self) -> SearchStatus | None:
@@ -430,7 +468,11 @@ class _Search:
         if node.state in self.closed:
             stats.reopened += 1
         self.closed[node.state] = node.g
-        for edge in self.successors(node.state):
+        edges: Iterable[Edge[Any, Any]] = self.successors(node.state)
+        if self.prefetch is not None and not self.deferred:
+            edges = list(edges)  # eager: every one is evaluated next, in this order
+            self.prefetch(edges)
+        for edge in edges:
             cost = edge.cost
             if not 0.0 <= cost < math.inf:
                 raise ValueError(f"edge cost must be finite and non-negative, got {cost!r}")
@@ -474,6 +516,8 @@ class _Search:
                     # simulation.
                     stats.pruned_duplicate += 1
                     continue
+                if self.prefetch is not None:
+                    self.prefetch([edge, *self.upcoming()])
                 evaluated = self.evaluate(parent, edge)
                 if evaluated is None:
                     continue
@@ -526,6 +570,8 @@ def best_first_search(
     progress: Callable[[SearchStats], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     clock: Callable[[], float] = time.monotonic,
+    prefetch: Callable[[list[Edge[S, A]]], None] | None = None,
+    prefetch_depth: int = 4,
 ) -> SearchResult[S, A]:
     """Best-first search from ``start`` to a state satisfying ``is_goal``.
 
@@ -591,6 +637,14 @@ def best_first_search(
         ``CANCELLED``.
     clock
         Monotonic clock in seconds, injectable for tests. Default: ``time.monotonic``.
+    prefetch
+        Told which edges the search will evaluate next, so that their children can be
+        computed ahead (in parallel): in deferred mode, before each popped edge is evaluated,
+        that edge and those of the next ``prefetch_depth`` open entries; in eager mode, all of
+        an expansion's edges before the first is evaluated. A hint only: the search evaluates
+        edges in the same order, calling ``make_child`` as it would without it.
+    prefetch_depth
+        Open entries looked at for ``prefetch`` in deferred mode (at most 10).
 
     Returns
     -------
@@ -616,6 +670,8 @@ def best_first_search(
         raise ValueError("dominance_key is only meaningful together with dominates")
     if dominance_index is not None and dominates is not None:
         raise ValueError("give either dominates or dominance_index, not both")
+    if not 0 <= prefetch_depth <= 10:
+        raise ValueError(f"prefetch_depth must be between 0 and 10, got {prefetch_depth!r}")
     search = _Search(
         successors,
         is_goal,
@@ -634,6 +690,8 @@ def best_first_search(
         progress=progress,
         should_stop=should_stop,
         clock=clock,
+        prefetch=prefetch,
+        prefetch_depth=prefetch_depth,
     )
     return search.run(start)
 

@@ -1,86 +1,205 @@
-"""Planning benchmark: deterministic and particle planners on the block-world problems.
+"""Planning benchmark: time, nodes, simulations and peak memory, old code against new, paired.
 
 Usage::
 
-    python benchmarks/planning.py [--problems blocks-2,blocks-3,blocks-4,blocks-7]
-        [--particles 50] [--workers 2] [--output planning-bench.csv]
+    python benchmarks/planning.py [--cases blocks-7:25,blocks-4:50] [--configs local:1,local:2]
+        [--baseline GITREF] [--repeats 3] [--seed 0] [--output planning-bench.csv]
 
-For each problem and semantics it prints and writes one row: status, wall time, nodes
-expanded, successors generated, transitions evaluated, physics simulations run and plan length.
-Each row is appended to the CSV as soon as it is measured, so an interrupted run keeps its rows.
+A case is ``PROBLEM:PARTICLES`` (0 particles: the deterministic planner); a config is
+``local:WORKERS`` or ``dask:WORKERS`` (a LocalCluster of that many processes). Every run is
+its own Python process (so peak memory is that run's and no pool or cache carries over), with
+``PYTHONPATH`` at this checkout, or, for ``--baseline GITREF``, at a copy of that commit made
+with ``git archive``; the baseline runs each config as its code understands it (``--workers``
+only: its ``plan`` knows no backend, so dask configs are not run for it). Old and new runs of a
+case alternate, repeat by repeat and in alternating order, so a pair shares the machine's load.
+
+Each run prints one row: wall seconds of the ``plan`` call (for dask, after the LocalCluster
+was started, which ``startup_s`` gives), nodes expanded, transitions
+evaluated, simulations (``transitions_simulated``), simulations per second, the process's peak
+resident memory (MB; worker processes not included) and the plan length; and whether its plan
+equals the first run's of the case (``same``). The summary gives, per case and config, the
+median seconds and the ratio old / new of the medians (paired in the sense above). Rows are
+appended to ``--output`` as they are measured.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import hashlib
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tarfile
+import tempfile
 import time
 from pathlib import Path
 
-from arrange_up.io.domains import load
-from arrange_up.planning.planner import plan
+ROOT = Path(__file__).resolve().parent.parent
 
 FIELDS = [
+    "code",
     "problem",
-    "semantics",
     "particles",
-    "seed",
-    "weight",
+    "config",
+    "repeat",
     "status",
     "seconds",
+    "startup_s",
     "expanded",
-    "generated",
     "evaluated",
-    "transitions_simulated",
+    "simulations",
+    "simulations_per_s",
+    "peak_mb",
     "plan_length",
+    "plan_hash",
+    "same",
 ]
+
+
+def child(problem_name: str, particles: int, seed: int, config: str) -> None:
+    """One planning run in this process (the code on ``PYTHONPATH``); prints a JSON row."""
+    import arrange_up
+    from arrange_up.planning.planner import plan
+
+    backend, workers = config.split(":")
+    options: dict = {"workers": int(workers)}
+    if backend != "local":
+        options["backend"] = backend
+    if particles == 0:
+        options.update(semantics="deterministic", particles=1, workers=1)
+    else:
+        options.update(particles=particles)
+    problem = arrange_up.load(problem_name)
+    startup = 0.0
+    if backend != "local":
+        # the cluster is started (and cached) first: "seconds" is the planning on it, as
+        # with --scheduler, and "startup_s" what starting a LocalCluster adds to a command
+        from arrange_up.parallel import get_runner
+
+        begin = time.perf_counter()
+        get_runner(backend, int(workers))
+        startup = time.perf_counter() - begin
+    start = time.perf_counter()
+    result = plan(problem, seed=seed, **options)
+    seconds = time.perf_counter() - start
+    stats = result.stats
+    actions = repr(result.actions).encode()
+    print(
+        json.dumps(
+            {
+                "status": str(result.status),
+                "seconds": round(seconds, 3),
+                "startup_s": round(startup, 3),
+                "expanded": stats["expanded"],
+                "evaluated": stats["evaluated"],
+                "simulations": stats["transitions_simulated"],
+                "simulations_per_s": round(stats["transitions_simulated"] / seconds, 1),
+                "peak_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
+                "plan_length": len(result.actions) if result.actions else 0,
+                "plan_hash": hashlib.sha256(actions).hexdigest()[:12],
+            }
+        ),
+        flush=True,
+    )
+
+
+def checkout(ref: str, into: Path) -> Path:
+    """The tree of commit ``ref`` extracted under ``into`` (``git archive``)."""
+    archive = into / "tree.tar"
+    with archive.open("wb") as handle:
+        subprocess.run(["git", "-C", str(ROOT), "archive", ref], stdout=handle, check=True)
+    tree = into / "tree"
+    tree.mkdir()
+    with tarfile.open(archive) as tar:
+        tar.extractall(tree, filter="data")
+    return tree
+
+
+def run(code_root: Path, case: tuple[str, int], config: str, seed: int) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(code_root)}
+    command = [sys.executable, str(Path(__file__).resolve()), "--child"]
+    command += [f"{case[0]}:{case[1]}", config, str(seed)]
+    done = subprocess.run(command, env=env, capture_output=True, text=True, cwd=code_root)
+    if done.returncode != 0:
+        raise SystemExit(f"run {case} {config} at {code_root} failed:\n{done.stderr}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problems", default="blocks-2,blocks-3,blocks-4,blocks-7")
-    parser.add_argument("--particles", type=int, default=50)
-    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--cases", default="blocks-7:25,blocks-4:50")
+    parser.add_argument("--configs", default="local:1,local:2")
+    parser.add_argument("--baseline", default=None, metavar="GITREF")
+    parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--weight", type=float, default=2.0)
     parser.add_argument("--output", type=Path, default=Path("planning-bench.csv"))
+    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        name, particles = args.child[0].rsplit(":", 1)
+        child(name, int(particles), int(args.child[2]), args.child[1])
+        return
 
-    new = not args.output.exists()
-    with args.output.open("a", newline="") as handle:
-        writer = csv.DictWriter(handle, FIELDS)
-        if new:
-            writer.writeheader()
-        print(" ".join(f"{f:>12}" for f in FIELDS))
-        for name in args.problems.split(","):
-            problem = load(name)
-            for semantics, particles in (("deterministic", 1), ("particles", args.particles)):
-                start = time.perf_counter()
-                result = plan(
-                    problem,
-                    semantics=semantics,
-                    particles=particles,
-                    seed=args.seed,
-                    weight=args.weight,
-                    workers=args.workers,
+    cases = [(c.rsplit(":", 1)[0], int(c.rsplit(":", 1)[1])) for c in args.cases.split(",")]
+    configs = args.configs.split(",")
+    with tempfile.TemporaryDirectory() as scratch:
+        codes = {"new": ROOT}
+        if args.baseline:
+            codes = {"old": checkout(args.baseline, Path(scratch)), "new": ROOT}
+        new_file = not args.output.exists()
+        times: dict[tuple, list[float]] = {}
+        with args.output.open("a", newline="") as handle:
+            writer = csv.DictWriter(handle, FIELDS)
+            if new_file:
+                writer.writeheader()
+            print(" ".join(f"{f:>10}" for f in FIELDS if f != "plan_hash"), flush=True)
+            for case in cases:
+                first_hash = None
+                for repeat in range(args.repeats):
+                    for config in configs:
+                        order = list(codes) if repeat % 2 == 0 else list(reversed(codes))
+                        for code in order:
+                            if code == "old" and not config.startswith("local:"):
+                                continue
+                            row = run(codes[code], case, config, args.seed)
+                            first_hash = first_hash or row["plan_hash"]
+                            row.update(
+                                code=code,
+                                problem=case[0],
+                                particles=case[1],
+                                config=config,
+                                repeat=repeat,
+                                same=row["plan_hash"] == first_hash,
+                            )
+                            times.setdefault((case, config, code), []).append(row["seconds"])
+                            writer.writerow(row)
+                            handle.flush()
+                            shown = (f for f in FIELDS if f != "plan_hash")
+                            print(" ".join(f"{str(row[f]):>10}" for f in shown), flush=True)
+    print("\nmedian seconds (old / new: the ratio of the medians)")
+    for case in cases:
+        for config in configs:
+            new = times.get((case, config, "new"))
+            old = times.get((case, config, "old"))
+            line = f"{case[0]}:{case[1]} {config}: new {statistics.median(new):.2f} s"
+            if old:
+                old_median = statistics.median(old)
+                line += (
+                    f", old {old_median:.2f} s, old/new {old_median / statistics.median(new):.2f}x"
                 )
-                row = {
-                    "problem": name,
-                    "semantics": semantics,
-                    "particles": result.particles,
-                    "seed": args.seed,
-                    "weight": args.weight,
-                    "status": result.status,
-                    "seconds": round(time.perf_counter() - start, 2),
-                    "expanded": result.stats["expanded"],
-                    "generated": result.stats["generated"],
-                    "evaluated": result.stats["evaluated"],
-                    "transitions_simulated": result.stats["transitions_simulated"],
-                    "plan_length": len(result.actions) if result.actions else "",
-                }
-                writer.writerow(row)
-                handle.flush()
-                print(" ".join(f"{str(row[f]):>12}" for f in FIELDS), flush=True)
+            print(line)
+    if args.baseline:
+        for case in cases:
+            base = times.get((case, "local:1", "old")) or times.get((case, configs[0], "old"))
+            for config in configs:
+                new = times.get((case, config, "new"))
+                if base and new:
+                    ratio = statistics.median(base) / statistics.median(new)
+                    print(f"{case[0]}:{case[1]} old local:1 / new {config}: {ratio:.2f}x")
 
 
 if __name__ == "__main__":

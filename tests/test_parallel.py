@@ -100,7 +100,14 @@ def test_missing_dask_gives_an_install_hint(monkeypatch):
         parallel.DaskRunner(workers=2)
 
 
-def test_dask_local_cluster_matches_local_processes():
+def _die_once(marker: str, item: int) -> int:
+    if not os.path.exists(marker):
+        open(marker, "w").close()
+        os._exit(1)  # the worker is lost with its task (and the context it held)
+    return item + 1
+
+
+def test_dask_local_cluster_matches_local_processes(tmp_path):
     pytest.importorskip("distributed")
     from arrange_up.evaluation.evaluate import evaluate_plan
     from arrange_up.io.domains import load
@@ -113,6 +120,10 @@ def test_dask_local_cluster_matches_local_processes():
         assert runner.workers == 2 and get_runner("dask", workers=2) is runner
         assert sorted(runner.map(_square, range(7), chunksize=2)) == [(i, i * i) for i in range(7)]
         on_dask = evaluate_plan(problem, actions, rollouts=20, seed=0, backend="dask", workers=2)
+        # a session's task whose worker dies with it is run again: the same answer
+        marker = tmp_path / "died"
+        assert runner.session(_die_once, str(marker)).submit(41).result() == 42
+        assert marker.exists()
     finally:
         parallel.shutdown()
     local = evaluate_plan(problem, actions, rollouts=20, seed=0, workers=2)

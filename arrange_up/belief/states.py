@@ -193,8 +193,23 @@ class ParticleBelief:
         #: Array ``(P, n_objects, 3)`` of every particle's poses, in ``names()`` order.
         self.poses = poses.reshape(len(particles), len(self._names), 3)
         self.poses.flags.writeable = False
+        self._hash = self._hash_of_poses()
+
+    def _hash_of_poses(self) -> int:
         # -0.0 == 0.0, so hash the array with its zeros made positive (adding 0.0 does that).
-        self._hash = hash((self._names, (self.poses + 0.0).tobytes()))
+        return hash((self._names, (self.poses + 0.0).tobytes()))
+
+    def __getstate__(self) -> dict:
+        # the hash is Python's, of a tuple holding strings: salted per process, so a belief
+        # that crosses to another process (a worker simulating a successor) hashes anew
+        state = dict(self.__dict__)
+        del state["_hash"]
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self.poses.flags.writeable = False
+        self._hash = self._hash_of_poses()
 
     def names(self) -> tuple[str, ...]:
         return self._names

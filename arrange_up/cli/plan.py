@@ -14,6 +14,7 @@ from arrange_up.cli.shared import (
     FiniteFloat,
     OutputFile,
     actions_table,
+    backend_choice,
     check_semantics,
     document_summary,
     echo_json,
@@ -21,13 +22,14 @@ from arrange_up.cli.shared import (
     json_option,
     library_default,
     load_problem,
+    parallel_options,
     seed_option,
     terminal_progress,
     timeout_option,
 )
 from arrange_up.io.planfile import plan_document, write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.parallel import available_cores
+from arrange_up.parallel import BackendUnavailableError, available_cores
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import DEFAULT_MAX_NODES, DEFAULT_WEIGHT
 from arrange_up.planning.planner import plan as run_plan
@@ -100,12 +102,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     help="Weighted A*: f = g + weight * h (1 = A*).",
 )
 @click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 256),
-    default=None,
-    help="Processes simulating particles (default: all cores; 1 for deterministic).",
-)
+@parallel_options("simulations of the successors the search will evaluate next")
 @click.option(
     "--model",
     default=None,
@@ -132,6 +129,8 @@ def plan(
     weight: float,
     no_dominance: bool,
     workers: int | None,
+    backend: str | None,
+    scheduler: str | None,
     model: str | None,
     output: str | None,
     as_json: bool,
@@ -143,12 +142,18 @@ def plan(
       arrange-up plan blocks-2 --semantics deterministic
       arrange-up plan blocks-4 --particles 50 --seed 1 --output blocks-4.plan.json
       arrange-up plan my-problem.yaml --timeout 300 --json
+      arrange-up plan blocks-7 --particles 25 --backend dask --scheduler tcp://10.0.0.5:8786
+
+    The workers simulate the pushes the search will evaluate next while it deals with the
+    current one; the plan does not depend on --workers or --backend (equal seeds give equal
+    plans). --workers defaults to all cores (1 for the deterministic semantics).
 
     Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted: the
     candidates ran out, unsolvable: proven, e.g. a goal part larger than the table), 2 bad
     input. An unsolved run prints one line of why.
     """
     check_semantics(semantics)
+    backend = backend_choice(backend, scheduler)
     loaded = load_problem(problem)
     if semantics == "cbst":
         _check_model(loaded, model)
@@ -174,9 +179,13 @@ def plan(
                 weight=weight,
                 dominance=not no_dominance,
                 workers=workers,
+                backend=backend,
+                scheduler=scheduler,
                 progress=update,
                 model=model,
             )
+    except BackendUnavailableError as error:  # dask missing, or the scheduler unreachable
+        fail(f"--backend {backend}: {error}")
     except (LookupError, ValueError) as error:  # a --model not found, unsound or not for cbst
         if model is None:
             raise

@@ -21,6 +21,8 @@ from arrange_up.belief.goals import PartMiss
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
+from arrange_up.parallel import get_runner
+from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
 from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_first_search
 
@@ -184,6 +186,11 @@ not, for plans an action or two longer (figures in docs/design/planning.md). ``w
 the thesis's A*."""
 
 
+#: Open entries the workers look ahead into for pushes to simulate: the entries that follow
+#: are mostly places (computed here when asked), so the next pushes lie a few levels down.
+PREFETCH_DEPTH = 8
+
+
 def plan(
     problem: ArrangementProblem,
     *,
@@ -197,6 +204,8 @@ def plan(
     weight: float = DEFAULT_WEIGHT,
     deferred: bool = True,
     workers: int = 1,
+    backend: str = "local",
+    scheduler: str | None = None,
     tie_break: bool = False,
     variety: bool = False,
     progress: ProgressCallback | None = None,
@@ -232,8 +241,14 @@ def plan(
         Deferred evaluation: a successor is simulated only when it is taken off the open list,
         not when generated. Most generated successors are never expanded, and simulating them
         is where the time goes.
-    workers
-        Processes that simulate a belief's particles in parallel (1: in this process).
+    workers, backend, scheduler
+        Where successor beliefs are computed (:func:`arrange_up.parallel.get_runner`):
+        ``"local"`` with ``workers`` processes (1: in this process), or ``"dask"``, a
+        LocalCluster of ``workers`` processes or the cluster at ``scheduler``. The workers
+        compute the successors the search will evaluate next while it deals with the current
+        one (:mod:`arrange_up.planning.successors`); the plan and the statistics do not depend
+        on where they run. Raises :class:`~arrange_up.parallel.BackendUnavailableError` when
+        dask is missing or the scheduler cannot be reached.
     tie_break
         Break ties among equally good nodes at random from ``seed`` (gives different but
         equally good plans for different seeds, e.g. for plan repair); default first-in
@@ -266,22 +281,28 @@ def plan(
     limit = (
         max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)
     )
+    # an unknown backend, a bad worker count or an unreachable scheduler fails before the
+    # task (and its worker processes) is built
+    runner = get_runner(backend, workers, scheduler)
     task = BeliefTask.build(
         problem,
         semantics=semantics,
         particles=particles,
         seed=seed,
-        workers=workers,
+        workers=1,  # the runner computes whole successors; no pool per transition
         heuristic=heuristic,
         dominance=dominance,
         variety=variety,
         model=model,
         start=start,
     )
+    index = task.dominance_index()
+    spec = WorkerSpec(problem, semantics, particles, seed, heuristic, model)
+    evaluator = SuccessorEvaluator(task, runner, spec, index)
 
     def report(stats: SearchStats) -> None:
         if progress is not None:
-            progress(SearchSnapshot.of(stats, task.semantics.simulations).to_json())
+            progress(SearchSnapshot.of(stats, evaluator.simulations).to_json())
 
     oversized = too_large(problem)
     try:
@@ -290,12 +311,12 @@ def plan(
         if not oversized:
             result = best_first_search(
                 task.initial_belief(),
-                task.successors,
+                evaluator.successors,
                 task.is_goal,
-                task.heuristic,
+                evaluator.heuristic,
                 weight=weight,
                 deferred=deferred,
-                dominance_index=task.dominance_index(),
+                dominance_index=index,
                 max_nodes=limit,
                 timeout=None
                 if timeout is None
@@ -303,12 +324,15 @@ def plan(
                 tie_break_seed=seed if tie_break else None,
                 progress=report,
                 should_stop=should_stop,
+                prefetch=evaluator.prefetch if evaluator.ahead else None,
+                prefetch_depth=PREFETCH_DEPTH,
             )
     finally:
+        evaluator.close()
         task.close()
     statistics = PlanStatistics(
         **{
-            **asdict(SearchSnapshot.of(result.stats, task.semantics.simulations)),
+            **asdict(SearchSnapshot.of(result.stats, evaluator.simulations)),
             "elapsed": time.monotonic() - started,
         },
         max_nodes=limit,

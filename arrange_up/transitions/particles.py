@@ -199,6 +199,25 @@ class ParticleSemantics:
             return None
         return self.moved_particles(belief, batch.outcomes)
 
+    def push_share(
+        self, belief: ParticleBelief, push: Push, indices: Sequence[int], affected: frozenset[str]
+    ) -> tuple[PushBatch, ParticleBelief | None]:
+        """Particles ``indices`` of ``belief`` pushed, simulating the ``affected`` objects (a
+        share of :meth:`apply`'s work, for a push that reaches something): their
+        :class:`PushBatch` and, when it is ok, the belief of those particles alone after the
+        push (the full child's rows at ``indices``).
+
+        Each particle's outcome is the one :meth:`apply` computes (its noise depends on its
+        index and state only), so shares put together (:meth:`moved_particles` over every
+        particle's outcome) give :meth:`apply`'s child.
+        """
+        states = belief.particles
+        share = ParticleBelief([states[i] for i in indices])
+        noises = [self.noise(i, states[i], push) for i in indices]
+        [batch] = self.simulate_pushes([self.push_jobs(share, push, affected, noises)])
+        self.simulations += len(indices)  # counted as _push counts: the share's every particle
+        return batch, (self.moved_particles(share, batch.outcomes) if batch.ok else None)
+
     def affected_objects(self, intervals: IntervalBelief, push: Push) -> frozenset[str]:
         """Objects the push may touch, directly or through others (a conservative sweep)."""
         spec = self.problem.object(push.manipulator)

@@ -41,7 +41,10 @@ Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` 
 ``model`` (``cbst`` only: a shipped model name or the card path of a model ``arrange-up
 train-cbst`` made; default the shipped one for the problem's controller; it is loaded and
 checked when the engine is made, and a problem whose controller is not the model's is
-refused).
+refused), ``workers`` (1), ``backend`` (``"local"`` or ``"dask"``) and ``scheduler`` (a Dask
+scheduler address): where the search's successors are simulated, which does not change the
+plan (:mod:`arrange_up.planning.successors`); a scheduler that cannot be reached is an
+``INTERNAL_ERROR`` with a log message saying so.
 Metrics hold the search statistics (expanded, generated, evaluated, pruned, elapsed, ...).
 
 **The reliability validator** (:class:`ArrangeUpReliability`) judges a plan by Monte Carlo
@@ -370,7 +373,16 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
     """Conformant belief-space planning for arrange-up problems (see the module doc)."""
 
     _NAME = ENGINE_NAME
-    _PARAMETERS = ("semantics", "particles", "seed", "max_nodes", "model")
+    _PARAMETERS = (
+        "semantics",
+        "particles",
+        "seed",
+        "max_nodes",
+        "model",
+        "workers",
+        "backend",
+        "scheduler",
+    )
 
     def __init__(
         self,
@@ -379,17 +391,22 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
         seed: int = 0,
         max_nodes: int | None = None,
         model: str | None = None,
+        workers: int = 1,
+        backend: str = "local",
+        scheduler: str | None = None,
         **unknown: Any,
     ) -> None:
         self._refuse_unknown(unknown)
         Engine.__init__(self)
         OneshotPlannerMixin.__init__(self)
         _check_params(semantics, particles, seed, max_nodes, model)
+        _check_parallel_params(ENGINE_NAME, workers, backend, scheduler)
         self._semantics = semantics
         self._particles = particles
         self._seed = seed
         self._max_nodes = max_nodes
         self._model = model
+        self._parallel = {"workers": workers, "backend": backend, "scheduler": scheduler}
 
     def _solve_with_params(
         self,
@@ -464,6 +481,7 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
                 progress=progress,
                 should_stop=out_of_time,
                 model=self._model,
+                **self._parallel,
             )
         except Exception as error:  # the engine must answer, not raise
             return result(
@@ -794,13 +812,19 @@ def _check_validator_params(
         raise ValueError(f"{VALIDATOR_NAME}: rollouts must be a positive integer, got {rollouts!r}")
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise ValueError(f"{VALIDATOR_NAME}: seed must be a non-negative integer, got {seed!r}")
+    _check_parallel_params(VALIDATOR_NAME, workers, backend, scheduler)
+
+
+def _check_parallel_params(engine: str, workers: Any, backend: Any, scheduler: Any) -> None:
+    """The ``workers`` (None: all cores), ``backend`` and ``scheduler`` parameters of an engine
+    that runs simulations on :func:`arrange_up.parallel.get_runner`."""
     if workers is not None and not _positive(workers):
-        raise ValueError(f"{VALIDATOR_NAME}: workers must be a positive integer, got {workers!r}")
+        raise ValueError(f"{engine}: workers must be a positive integer, got {workers!r}")
     if backend not in BACKENDS:
         expected = " or ".join(repr(b) for b in BACKENDS)
-        raise ValueError(f"{VALIDATOR_NAME}: backend must be {expected}, got {backend!r}")
+        raise ValueError(f"{engine}: backend must be {expected}, got {backend!r}")
     if scheduler is not None and (backend != "dask" or not isinstance(scheduler, str)):
-        raise ValueError(f"{VALIDATOR_NAME}: a scheduler address needs backend='dask'")
+        raise ValueError(f"{engine}: a scheduler address needs backend='dask'")
 
 
 # ---------------------------------------------------------------------------------------------

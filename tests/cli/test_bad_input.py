@@ -344,6 +344,11 @@ COMMAND_CASES: dict[str, tuple[list[str], tuple[str, ...]]] = {
     "plan-a-folder": (["plan", "{tmp}"], ("directory",)),
     "plan-unknown-semantics": ([*QUICK_PLAN, "--semantics", "magic"], ("--semantics",)),
     "plan-unknown-heuristic": ([*QUICK_PLAN, "--heuristic", "magic"], ("--heuristic",)),
+    "plan-scheduler-local": (
+        [*QUICK_PLAN, "--backend", "local", "--scheduler", "tcp://127.0.0.1:1"],
+        ("--scheduler",),
+    ),
+    "plan-unknown-backend": ([*QUICK_PLAN, "--backend", "ray"], ("--backend",)),
     "evaluate-seed-negative": ([*QUICK_EVALUATE, "--seed", "-1"], ("--seed",)),
     "evaluate-rollouts-zero": ([*QUICK_EVALUATE, "--rollouts", "0"], ("--rollouts",)),
     "evaluate-workers-zero": ([*QUICK_EVALUATE, "--workers", "0"], ("--workers",)),

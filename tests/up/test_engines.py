@@ -343,3 +343,16 @@ def test_an_exhausted_search_is_incomplete_and_a_too_large_part_proven_unsolvabl
     assert proven.log_messages[0].message == (
         "A cannot fit on the table in any orientation: no plan exists"
     )
+
+
+def test_the_planner_engine_runs_its_successors_where_told_with_the_same_plan():
+    problem = to_up(load("blocks-2"))
+    params = {"particles": 5, "seed": 0}
+    here = _solve(problem, {**params, "workers": 1})
+    pooled = _solve(problem, {**params, "workers": 2, "backend": "local"})
+    assert here.status is Status.SOLVED_SATISFICING
+    assert str(pooled.plan) == str(here.plan)
+    with pytest.raises(ValueError, match="backend must be"):
+        OneshotPlanner(name="arrange-up", params={"backend": "ray"})
+    with pytest.raises(ValueError, match="scheduler address needs"):
+        OneshotPlanner(name="arrange-up", params={"scheduler": "tcp://127.0.0.1:1"})
