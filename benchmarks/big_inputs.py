@@ -175,6 +175,49 @@ def squeezed(n: int) -> str:
     )
 
 
+def featured(n: int, feature: str) -> str:
+    """:func:`many_objects` (``n`` uncertain unit boxes) written with one YAML feature on every
+    line: ``anchors`` (each pose's x anchored, the shared shape and noise aliased), ``merges``
+    (each object and initial state merged from an anchored mapping by ``<<``), ``tags`` (``!!map``
+    and ``!!float`` throughout), ``directives`` (``%YAML 1.1`` and a ``%TAG`` handle used on every
+    number) or ``tabs`` (a tab after every colon and comma in block and flow context)."""
+    side = math.ceil(math.sqrt(n))
+    f = "!f!float " if feature == "directives" else "!!float " if feature == "tags" else ""
+    m = "!!map " if feature == "tags" else ""
+    lines = [f"name: {feature}-{n}", f"table: {{size: [{f}{2.0 * side}, {f}{2.0 * side}]}}"]
+    lines.append("objects:")
+    for k in range(n):
+        if feature == "anchors":
+            shape = "&shape {box: [1.0, 1.0]}" if k == 0 else "*shape"
+            lines.append(f"  O{k}: {{kind: part, shape: {shape}}}")
+        elif feature == "merges":
+            body = "&part {kind: part, shape: {box: [1.0, 1.0]}}" if k == 0 else "{<<: *part}"
+            lines.append(f"  O{k}: {body}")
+        else:
+            lines.append(f"  O{k}: {m}{{kind: part, shape: {m}{{box: [{f}1.0, {f}1.0]}}}}")
+    lines.append("initial:")
+    for k in range(n):
+        x, y = 1.0 + 2.0 * (k % side), 1.0 + 2.0 * (k // side)
+        if feature == "anchors":
+            noise = "&noise [0.1, 0.1, 5]" if k == 0 else "*noise"
+            lines.append(f"  O{k}: {{pose: [&x{k} {x:.6f}, {y:.6f}, 0], uncertainty: {noise}}}")
+        elif feature == "merges":
+            base = "&base {uncertainty: [0.1, 0.1, 5]}" if k == 0 else "*base"
+            lines.append(f"  O{k}: {{<<: {base}, pose: [{x:.6f}, {y:.6f}, 0]}}")
+        else:
+            lines.append(
+                f"  O{k}: {m}{{pose: [{f}{x:.6f}, {f}{y:.6f}, {f}0], uncertainty: "
+                f"[{f}0.1, {f}0.1, {f}5]}}"
+            )
+    lines += ["goal:", "  tolerance: [0.2, 0.2]", "  poses: {O0: [1.0, 1.0, 0]}"]
+    text = "\n".join(lines) + "\n"
+    if feature == "directives":
+        text = "%YAML 1.1\n%TAG !f! tag:yaml.org,2002:\n---\n" + text
+    if feature == "tabs":
+        text = text.replace(": ", ":\t").replace(", ", ",\t")
+    return text
+
+
 #: The files of ``--files``: name -> text (each at most 1 MB).
 KINDS = {
     "star-35000": lambda: star_problem(35_000),
@@ -185,6 +228,11 @@ KINDS = {
     "polygons-10x1000": lambda: many_polygons(10, 1_000),
     "parts-2500": lambda: many_parts(2_500),
     "squeezed-1000": lambda: squeezed(1_000),
+    "anchors-8000": lambda: featured(8_000, "anchors"),
+    "merges-8500": lambda: featured(8_500, "merges"),
+    "tags-4000": lambda: featured(4_000, "tags"),
+    "directives-4000": lambda: featured(4_000, "directives"),
+    "tabs-8500": lambda: featured(8_500, "tabs"),
 }
 
 
