@@ -5,6 +5,7 @@
     python benchmarks/big_inputs.py --limit-gb 4     # kill a child above 4 GB (default 4)
     python benchmarks/big_inputs.py --files          # files up to 1 MB of every kind: parse, check
     python benchmarks/big_inputs.py --files --baseline REV   # and check them with the tree at REV
+    python benchmarks/big_inputs.py --files --kinds tabs-8500 merges-8500   # only these files
 
 Without ``--files``, generates YAML problems whose one part is a star polygon (alternating
 radii, so it is not convex and must be decomposed) with ``--vertices`` vertices (default:
@@ -23,13 +24,15 @@ not scale fails instead of exhausting the machine. One run each: the figures are
 a 35,000-vertex polygon in 1 MB, the same file cut off mid-list, 8,500 uncertain objects, a
 thousand objects stacked at one pose, a hundred objects sharing a 1,000-vertex shape, ten
 1,000-vertex polygons, a shape of 2,500 convex parts, a 1,000-vertex part squeezed between two
-walls) and prints, for each, the size, the time to parse it with ruamel's round-trip loader
-(the reading before libyaml, which every YAML file went through) and with
+walls, and the objects written with anchors, merge keys, explicit tags, directives or tabs
+throughout, :func:`featured`) and prints, for each, the size, the time to parse it with
+ruamel's round-trip loader (the reading before libyaml) and with
 :func:`arrange_up.io.yaml_tree.read` (libyaml, ruamel for what it leaves), each the best of
-three in this process, and the wall and CPU (user + system) time of ``arrange-up check FILE``
-in a fresh subprocess; with ``--baseline REV``, also ``check`` run from the tree of the git
-revision REV (exported to a temporary folder), on the same files (``+``: stopped after
-``--timeout`` seconds). One run each: the figures are one run's.
+three in this process, and the wall and CPU (user + system) time and peak resident memory of
+``arrange-up check FILE`` in a fresh subprocess; with ``--baseline REV``, also ``check`` run
+from the tree of the git revision REV (exported to a temporary folder), on the same files
+(``+``: stopped after ``--timeout`` seconds). ``--kinds NAME ...`` runs only those files. One
+run each: the figures are one run's.
 """
 
 from __future__ import annotations
@@ -261,31 +264,32 @@ def _export(revision: str, into: Path) -> Path:
     return into
 
 
-def files(timeout: float, limit: int, baseline: str | None) -> None:
+def files(timeout: float, limit: int, baseline: str | None, kinds: list[str]) -> None:
     from arrange_up.io import yaml_tree
 
     with tempfile.TemporaryDirectory() as tmp:
         old_tree = _export(baseline, Path(tmp) / "baseline") if baseline else None
-        header = f"{'file':<20} {'kB':>6}  parse s: ruamel libyaml  check: wall s  CPU s"
-        print(header + (f"  at {baseline}: wall s  CPU s" if baseline else ""))
-        for name, make in KINDS.items():
+        header = f"{'file':<20} {'kB':>6}  parse s: ruamel libyaml  check: wall s  CPU s  MB"
+        print(header + (f"  at {baseline}: wall s  CPU s  MB" if baseline else ""), flush=True)
+        for name in kinds:
+            make = KINDS[name]
             text = make()
             path = Path(tmp) / f"{name}.yaml"
             path.write_text(text, encoding="utf-8")
             old_parse = _best_of_three(lambda text=text: yaml_tree.read_ruamel(text))
             new_parse = _best_of_three(lambda text=text: yaml_tree.read(text))
-            status, seconds, _, cpu = run_child(["check", str(path)], timeout, limit)
+            status, seconds, peak, cpu = run_child(["check", str(path)], timeout, limit)
             line = (
                 f"{name:<20} {len(text.encode()) / 1000:6.0f}  {old_parse:14.2f} "
-                f"{new_parse:7.2f}  {seconds:13.2f}  {cpu:5.2f}"
+                f"{new_parse:7.2f}  {seconds:13.2f}  {cpu:5.2f}  {peak:4.0f}"
             )
             if old_tree is not None:
-                old_status, old_seconds, _, old_cpu = run_child(
+                old_status, old_seconds, old_peak, old_cpu = run_child(
                     ["check", str(path)], timeout, limit, pythonpath=old_tree
                 )
                 stopped = "+" if old_status.startswith("stopped") else " "
-                line += f"  {old_seconds:19.2f}{stopped} {old_cpu:5.2f}"
-            print(line + f"  ({status[:40]})")
+                line += f"  {old_seconds:19.2f}{stopped} {old_cpu:5.2f}  {old_peak:4.0f}"
+            print(line + f"  ({status[:40]})", flush=True)
 
 
 def _limit(limit_bytes: int) -> None:
@@ -347,10 +351,11 @@ def main() -> None:
     parser.add_argument("--limit-gb", type=float, default=4.0)
     parser.add_argument("--files", action="store_true", help="files up to 1 MB of every kind")
     parser.add_argument("--baseline", help="with --files: also check with the tree at this rev")
+    parser.add_argument("--kinds", nargs="+", choices=sorted(KINDS), default=list(KINDS))
     options = parser.parse_args()
     limit = int(options.limit_gb * 2**30)
     if options.files:
-        files(options.timeout, limit, options.baseline)
+        files(options.timeout, limit, options.baseline, options.kinds)
         return
     with tempfile.TemporaryDirectory() as tmp:
         for n in sorted(options.vertices):
