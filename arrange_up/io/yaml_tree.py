@@ -3,16 +3,31 @@ where it is written, and the duplicate keys.
 
 Two parsers build the same tree (:class:`YamlMap`, :class:`YamlSeq` and scalars):
 
-* **libyaml** (PyYAML's C parser, read event by event here): the fast reading. It takes what
-  problem files are made of: one document of mappings with scalar keys, lists, plain and quoted
-  scalars, anchors and aliases of mappings and lists.
-* **ruamel's round-trip loader**: the reference reading. It reads every document the libyaml
-  reading does not take (:class:`Unsupported`: directives, explicit tags, merge keys, anchored
-  scalars, timestamps, integers other than plain decimals, numbers with ``_``, tabs and rare
-  characters, nesting deeper than :data:`MAX_FAST_DEPTH`), every document libyaml refuses (so
-  ruamel words each syntax error), and everything when PyYAML was built without libyaml.
+* **libyaml** (PyYAML's C parser, read event by event here): the fast reading, of any one
+  document: anchors and aliases of any node, merge keys (``<<``), explicit tags, ``%YAML 1.1`` /
+  ``1.2`` and ``%TAG`` directives, tabs where YAML allows them. It means what ruamel's reading
+  means: plain scalars are resolved by ruamel's own resolver table of the document's YAML
+  version; scalars it does not build itself (anchored or tagged ones, other integer bases,
+  timestamps, ...) and collections with a tag other than ``!!map`` / ``!!seq`` are built by
+  ruamel's round-trip constructor from nodes made of libyaml's events; merge keys are merged as
+  that constructor merges them (the mapping's own keys first, then each merged mapping's keys
+  not given yet, the first merged first) and refused with its errors; duplicate keys are found
+  at the paths ruamel's walk of its node tree names; an undefined alias or a second document is
+  ruamel's error.
+* **ruamel's round-trip loader**: the reference reading, pure Python and many times slower
+  (``benchmarks/big_inputs.py --files``). It reads the few
+  documents the libyaml reading does not take (:class:`Unsupported`: recursive aliases,
+  collections as mapping keys, NEL, LS, PS and byte-order marks in the text (which libyaml reads
+  as YAML 1.1 line breaks and ruamel otherwise), control characters (which ruamel refuses
+  before parsing), nesting deeper than :data:`MAX_FAST_DEPTH`, several errors of building values
+  (ruamel's order of building decides which is reported), and a few tag spellings the two
+  scanners read differently), words every syntax error libyaml finds (from a short text), and
+  reads everything when PyYAML was built without libyaml.
 
-Plain scalars are read by ruamel's YAML 1.2 rules in both (its own resolver table): ``yes``,
+Tabs: YAML allows a tab between tokens on a line (``a:\t1``); libyaml reads it, ruamel refuses
+it outside flow collections. The fast reading reads such files; ruamel words a syntax error
+found after such a tab in the text with those tabs made spaces (:func:`_untabbed`).
+Plain scalars are read by ruamel's YAML 1.2 rules unless ``%YAML 1.1`` says otherwise: ``yes``,
 ``on`` and ``1:30`` are strings, ``1e3`` is 1000.0, ``017`` is 17, ``.inf`` is infinite. A file
 means the same whichever parser reads it; ``tests/io/test_yaml_tree.py`` compares the two.
 """
