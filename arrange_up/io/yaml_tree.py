@@ -948,6 +948,7 @@ class _Composer:
                     continue
             elif kind is MappingEndEvent or kind is SequenceEndEvent:
                 frame = stack.pop()
+                frame.first = None  # type: ignore[assignment]  # (the frame stays, for the walk)
                 value, line, column = frame.value, frame.line, frame.column
                 if frame.merges:
                     for merged in frame.merges:
