@@ -428,7 +428,8 @@ class _Frame:
         self.key: tuple[Any, str, str, int, int] | None = None  # value, tag, text, line, column
         self.first: dict[tuple[str, str], tuple[int, int]] = {}
         self.dups: list[tuple[int, int, str, tuple[int, int]]] | None = None
-        self.kids: list[tuple[Any, Any]] = []  # (key text or item index, _Frame or _Delegated)
+        # (key text or item index, _Frame or _Delegated) of each child that is a collection
+        self.kids: list[tuple[Any, Any]] | None = None
         self.failed = self.flow = False
         self.merges: list[YamlMap] | None = None
         # Where the first and the latest child (item, or key of a pair) start in the text.
@@ -948,7 +949,7 @@ class _Composer:
                     continue
             elif kind is MappingEndEvent or kind is SequenceEndEvent:
                 frame = stack.pop()
-                frame.first = None  # type: ignore[assignment]  # (the frame stays, for the walk)
+                frame.first = frame.path = None  # type: ignore[assignment]  # kept for the walk
                 value, line, column = frame.value, frame.line, frame.column
                 if frame.merges:
                     for merged in frame.merges:
@@ -981,6 +982,8 @@ class _Composer:
             container = parent.value
             if type(container) is YamlSeq:
                 if child is not None:
+                    if parent.kids is None:
+                        parent.kids = []
                     parent.kids.append((len(container), child))
                 container.append(value)
                 container.marks.append((line, column))
@@ -1013,6 +1016,8 @@ class _Composer:
                 else:
                     parent.first[ident] = (key_line + 1, key_column + 1)
                 if child is not None:
+                    if parent.kids is None:
+                        parent.kids = []
                     parent.kids.append((key_text, child))
                 if key not in container:  # a later equal key is dropped, as ruamel drops it
                     container[key] = value
@@ -1055,5 +1060,5 @@ def _walk_duplicates(root: Any) -> Iterator[Duplicate]:
         for line, column, key_text, first in entry.dups or ():
             yield line, column, join(path, key_text), key_text, first
         mapping = type(entry.value) is YamlMap
-        for label, kid in entry.kids:
+        for label, kid in entry.kids or ():
             stack.append((kid, join(path, label) if mapping else f"{path}[{label}]"))
