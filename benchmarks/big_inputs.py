@@ -5,6 +5,7 @@
     python benchmarks/big_inputs.py --limit-gb 4     # kill a child above 4 GB (default 4)
     python benchmarks/big_inputs.py --files          # files up to 1 MB of every kind: parse, check
     python benchmarks/big_inputs.py --files --baseline REV   # and check them with the tree at REV
+    python benchmarks/big_inputs.py --files --kinds tabs-8500 merges-8500   # only these files
 
 Without ``--files``, generates YAML problems whose one part is a star polygon (alternating
 radii, so it is not convex and must be decomposed) with ``--vertices`` vertices (default:
@@ -19,17 +20,19 @@ and prints the file size, exit status, wall time and peak resident memory of eac
 ``--timeout`` seconds and its address space limited to ``--limit-gb`` so that a run that does
 not scale fails instead of exhausting the machine. One run each: the figures are one run's.
 
-``--files`` generates one file of each kind that makes checking expensive (see :data:`KINDS`:
-a 35,000-vertex polygon in 1 MB, the same file cut off mid-list, 8,500 uncertain objects, a
+``--files`` generates one file of each kind that makes checking expensive (see :data:`KINDS`: a
+35,000-vertex polygon in 1 MB, the same file cut off mid-list, 8,500 uncertain objects, a
 thousand objects stacked at one pose, a hundred objects sharing a 1,000-vertex shape, ten
 1,000-vertex polygons, a shape of 2,500 convex parts, a 1,000-vertex part squeezed between two
-walls) and prints, for each, the size, the time to parse it with ruamel's round-trip loader
-(the reading before libyaml, which every YAML file went through) and with
-:func:`arrange_up.io.yaml_tree.read` (libyaml, ruamel for what it leaves), each the best of
-three in this process, and the wall and CPU (user + system) time of ``arrange-up check FILE``
-in a fresh subprocess; with ``--baseline REV``, also ``check`` run from the tree of the git
-revision REV (exported to a temporary folder), on the same files (``+``: stopped after
-``--timeout`` seconds). One run each: the figures are one run's.
+walls, and the objects written with anchors, merge keys, explicit tags, directives or tabs
+throughout, :func:`featured`) and prints, for each, the size, the time to parse it with ruamel's
+round-trip loader (the reading before libyaml) and with :func:`arrange_up.io.yaml_tree.read`
+(libyaml, ruamel for what it leaves), each the best of three in this process (one run when it
+takes over 10 s), and the wall and CPU (user + system) time and peak resident memory of
+``arrange-up check FILE`` in a fresh subprocess; with ``--baseline REV``, also ``check`` run
+from the tree of the git revision REV (exported to a temporary folder), on the same files
+(``+``: stopped after ``--timeout`` seconds). ``--kinds NAME ...`` runs only those files. One
+run each: the figures are one run's.
 """
 
 from __future__ import annotations
@@ -175,6 +178,49 @@ def squeezed(n: int) -> str:
     )
 
 
+def featured(n: int, feature: str) -> str:
+    """:func:`many_objects` (``n`` uncertain unit boxes) written with one YAML feature on every
+    line: ``anchors`` (each pose's x anchored, the shared shape and noise aliased), ``merges``
+    (each object and initial state merged from an anchored mapping by ``<<``), ``tags`` (``!!map``
+    and ``!!float`` throughout), ``directives`` (``%YAML 1.1`` and a ``%TAG`` handle used on every
+    number) or ``tabs`` (a tab after every colon and comma in block and flow context)."""
+    side = math.ceil(math.sqrt(n))
+    f = "!f!float " if feature == "directives" else "!!float " if feature == "tags" else ""
+    m = "!!map " if feature == "tags" else ""
+    lines = [f"name: {feature}-{n}", f"table: {{size: [{f}{2.0 * side}, {f}{2.0 * side}]}}"]
+    lines.append("objects:")
+    for k in range(n):
+        if feature == "anchors":
+            shape = "&shape {box: [1.0, 1.0]}" if k == 0 else "*shape"
+            lines.append(f"  O{k}: {{kind: part, shape: {shape}}}")
+        elif feature == "merges":
+            body = "&part {kind: part, shape: {box: [1.0, 1.0]}}" if k == 0 else "{<<: *part}"
+            lines.append(f"  O{k}: {body}")
+        else:
+            lines.append(f"  O{k}: {m}{{kind: part, shape: {m}{{box: [{f}1.0, {f}1.0]}}}}")
+    lines.append("initial:")
+    for k in range(n):
+        x, y = 1.0 + 2.0 * (k % side), 1.0 + 2.0 * (k // side)
+        if feature == "anchors":
+            noise = "&noise [0.1, 0.1, 5]" if k == 0 else "*noise"
+            lines.append(f"  O{k}: {{pose: [&x{k} {x:.6f}, {y:.6f}, 0], uncertainty: {noise}}}")
+        elif feature == "merges":
+            base = "&base {uncertainty: [0.1, 0.1, 5]}" if k == 0 else "*base"
+            lines.append(f"  O{k}: {{<<: {base}, pose: [{x:.6f}, {y:.6f}, 0]}}")
+        else:
+            lines.append(
+                f"  O{k}: {m}{{pose: [{f}{x:.6f}, {f}{y:.6f}, {f}0], uncertainty: "
+                f"[{f}0.1, {f}0.1, {f}5]}}"
+            )
+    lines += ["goal:", "  tolerance: [0.2, 0.2]", "  poses: {O0: [1.0, 1.0, 0]}"]
+    text = "\n".join(lines) + "\n"
+    if feature == "directives":
+        text = "%YAML 1.1\n%TAG !f! tag:yaml.org,2002:\n---\n" + text
+    if feature == "tabs":
+        text = text.replace(": ", ":\t").replace(", ", ",\t")
+    return text
+
+
 #: The files of ``--files``: name -> text (each at most 1 MB).
 KINDS = {
     "star-35000": lambda: star_problem(35_000),
@@ -185,12 +231,21 @@ KINDS = {
     "polygons-10x1000": lambda: many_polygons(10, 1_000),
     "parts-2500": lambda: many_parts(2_500),
     "squeezed-1000": lambda: squeezed(1_000),
+    "anchors-8000": lambda: featured(8_000, "anchors"),
+    "merges-8500": lambda: featured(8_500, "merges"),
+    "tags-4000": lambda: featured(4_000, "tags"),
+    "directives-4000": lambda: featured(4_000, "directives"),
+    "tabs-8500": lambda: featured(8_500, "tabs"),
 }
 
 
 def _best_of_three(function: Callable[[], object]) -> float:
-    times = []
+    """The least of three runs' seconds (of one run when it takes over 10 s: ruamel's reading of
+    many merge keys is quadratic)."""
+    times: list[float] = []
     for _ in range(3):
+        if times and times[0] > 10.0:
+            break
         t0 = time.perf_counter()
         try:
             function()
@@ -213,31 +268,32 @@ def _export(revision: str, into: Path) -> Path:
     return into
 
 
-def files(timeout: float, limit: int, baseline: str | None) -> None:
+def files(timeout: float, limit: int, baseline: str | None, kinds: list[str]) -> None:
     from arrange_up.io import yaml_tree
 
     with tempfile.TemporaryDirectory() as tmp:
         old_tree = _export(baseline, Path(tmp) / "baseline") if baseline else None
-        header = f"{'file':<20} {'kB':>6}  parse s: ruamel libyaml  check: wall s  CPU s"
-        print(header + (f"  at {baseline}: wall s  CPU s" if baseline else ""))
-        for name, make in KINDS.items():
+        header = f"{'file':<20} {'kB':>6}  parse s: ruamel libyaml  check: wall s  CPU s  MB"
+        print(header + (f"  at {baseline}: wall s  CPU s  MB" if baseline else ""), flush=True)
+        for name in kinds:
+            make = KINDS[name]
             text = make()
             path = Path(tmp) / f"{name}.yaml"
             path.write_text(text, encoding="utf-8")
             old_parse = _best_of_three(lambda text=text: yaml_tree.read_ruamel(text))
             new_parse = _best_of_three(lambda text=text: yaml_tree.read(text))
-            status, seconds, _, cpu = run_child(["check", str(path)], timeout, limit)
+            status, seconds, peak, cpu = run_child(["check", str(path)], timeout, limit)
             line = (
                 f"{name:<20} {len(text.encode()) / 1000:6.0f}  {old_parse:14.2f} "
-                f"{new_parse:7.2f}  {seconds:13.2f}  {cpu:5.2f}"
+                f"{new_parse:7.2f}  {seconds:13.2f}  {cpu:5.2f}  {peak:4.0f}"
             )
             if old_tree is not None:
-                old_status, old_seconds, _, old_cpu = run_child(
+                old_status, old_seconds, old_peak, old_cpu = run_child(
                     ["check", str(path)], timeout, limit, pythonpath=old_tree
                 )
                 stopped = "+" if old_status.startswith("stopped") else " "
-                line += f"  {old_seconds:19.2f}{stopped} {old_cpu:5.2f}"
-            print(line + f"  ({status[:40]})")
+                line += f"  {old_seconds:19.2f}{stopped} {old_cpu:5.2f}  {old_peak:4.0f}"
+            print(line + f"  ({status[:40]})", flush=True)
 
 
 def _limit(limit_bytes: int) -> None:
@@ -299,10 +355,11 @@ def main() -> None:
     parser.add_argument("--limit-gb", type=float, default=4.0)
     parser.add_argument("--files", action="store_true", help="files up to 1 MB of every kind")
     parser.add_argument("--baseline", help="with --files: also check with the tree at this rev")
+    parser.add_argument("--kinds", nargs="+", choices=sorted(KINDS), default=list(KINDS))
     options = parser.parse_args()
     limit = int(options.limit_gb * 2**30)
     if options.files:
-        files(options.timeout, limit, options.baseline)
+        files(options.timeout, limit, options.baseline, options.kinds)
         return
     with tempfile.TemporaryDirectory() as tmp:
         for n in sorted(options.vertices):

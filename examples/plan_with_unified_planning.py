@@ -14,12 +14,15 @@ from __future__ import annotations
 
 import sys
 
-from unified_planning.shortcuts import OneshotPlanner, PlanValidator
+from unified_planning.shortcuts import OneshotPlanner, PlanValidator, get_environment
 
 import arrange_up
 
 
 def main(name: str = "blocks-2") -> int:
+    # unified-planning prints each engine's credits (a coloured banner) on standard output when
+    # it makes the engine, in among the answers below; the engine's get_credits() still has them.
+    get_environment().credits_stream = None
     problem = arrange_up.to_up(arrange_up.load(name))
     params = {"semantics": "deterministic", "seed": 0}
     with OneshotPlanner(name="arrange-up", params=params) as planner:

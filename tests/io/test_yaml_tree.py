@@ -1,11 +1,15 @@
 """Tests of ``arrange_up.io.yaml_tree``: libyaml's reading gives the tree ruamel's reading gives
-(values, their types as the readers see them, every position, duplicate keys), leaves to ruamel
-what it does not take, and syntax errors keep ruamel's words and places."""
+(values, their types as the readers see them, every position, duplicate keys) and ruamel's
+errors, for plain files and for every feature (anchors, aliases, merge keys, tags, directives,
+tabs; hand-written cases and generated documents), leaves to ruamel what it does not take, and
+syntax errors keep ruamel's words and places."""
 
 from __future__ import annotations
 
 import math
 import random
+import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -17,10 +21,15 @@ from arrange_up.io.yaml_source import Report, parse
 from arrange_up.io.yaml_tree import Document, Refused, Unsupported, YamlMap, YamlSeq
 
 REPOSITORY = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(REPOSITORY / "benchmarks"))
+from big_inputs import featured  # noqa: E402
+from yaml_documents import documents  # noqa: E402
 
 pytestmark = [
     pytest.mark.skipif(yaml_tree.CParser is None, reason="PyYAML without libyaml"),
     pytest.mark.filterwarnings("ignore:\\s*found duplicate anchor"),  # ruamel's, for a case
+    pytest.mark.filterwarnings("ignore::ruamel.yaml.error.MantissaNoDotYAML1_1Warning"),
 ]
 
 
@@ -135,19 +144,11 @@ def test_libyaml_reads_the_tree_ruamel_reads(name: str) -> None:
     assert_same_document(yaml_tree.read_libyaml(text), yaml_tree.read_ruamel(text))
 
 
-def test_every_plain_scalar_reads_as_ruamel_reads_it_or_is_left_to_ruamel() -> None:
-    taken = 0
+def test_every_plain_scalar_reads_as_ruamel_reads_it() -> None:
     for scalar in SCALARS:
-        text = f"key: {scalar}\nlist: [{scalar}]\n{scalar}: key\n"
-        reference = yaml_tree.read_ruamel(text)
-        try:
-            fast = yaml_tree.read_libyaml(text)
-        except Unsupported:
-            assert_same_document(yaml_tree.read(text), reference)
-            continue
-        assert_same_document(fast, reference)
-        taken += 1
-    assert taken >= len(SCALARS) - 6  # all but the rare integers and timestamps
+        for version in ("", "%YAML 1.1\n---\n"):
+            text = f"{version}key: {scalar}\nlist: [{scalar}]\n{scalar}: key\n"
+            assert_same_document(yaml_tree.read_libyaml(text), yaml_tree.read_ruamel(text))
 
 
 @pytest.mark.parametrize(
@@ -207,34 +208,194 @@ def test_positions_of_an_aliased_value_are_those_of_its_anchor() -> None:
 
 
 # ---------------------------------------------------------------------------------------------
+# every feature: the same tree or the same error
+# ---------------------------------------------------------------------------------------------
+#: Every feature the libyaml reading takes besides plain files: the same tree, or the same error.
+FEATURES = {
+    "directive 1.1": "%YAML 1.1\n---\na: yes\nb: 017\nc: 1:30\nd: on\ne: 0b101\nf: 1.5\ng: 1e3\n",
+    "directive 1.2": "%YAML 1.2\n---\na: yes\nb: 017\n",
+    "tag directive": "%TAG !e! tag:yaml.org,2002:\n---\na: !e!float 1\nb: !e!str x\n",
+    "explicit tag": "a: !!str 1\nb: !!float 2\nc: !!int '3'\nd: !!bool yes\ne: !!null ''\n",
+    "tagged collections": "a: !!map {b: 1}\nc: !!seq [1]\nd: ! [2]\n",
+    "verbatim tag": "a: !<tag:yaml.org,2002:str> 1\nb: !<tag:yaml.org,2002:float> 2\n",
+    "local tag": "a: !thing 1\nb: !thing {x: 1}\nc: !thing [1, 2]\n",
+    "non-specific tag": "a: ! 1\nb: ! 'x'\n",
+    "rare standard tags": (
+        "a: !!set {x, y}\nb: !!omap [c: 1]\nc: !!binary aGVsbG8=\nd: !!timestamp 2024-01-01\n"
+        "e: !!pairs [f: 1]\n"
+    ),
+    "tag and anchor": "a: !!float &x 1\nb: &y !!float 2\nc: [*x, *y]\nd: !!map &m {e: 1}\nf: *m\n",
+    "tag not followed by a space": "a: [!<tag:yaml.org,2002:str>, 1]\n",
+    "merge key": "base: &b {x: 1, y: 2}\nc:\n  <<: *b\n  y: 3\n",
+    "merge of a list": "b1: &b1 {x: 1, y: 2}\nb2: &b2 {x: 3, z: 4}\nc:\n  w: 0\n  <<: [*b1, *b2]\n",
+    "merge inline": "c: {<<: {x: 1, x: 2}, y: 3}\n",
+    "merge of a merged mapping": "a: &a {x: 1}\nb: &b {<<: *a, y: 2}\nc: {<<: *b, z: 3}\n",
+    "merge of a scalar": "c:\n  <<: 1\n",
+    "merge of an empty value": "c:\n  <<:\n  d: 1\n",
+    "merge of an empty value in flow": "e: {<<: }\n",
+    "merge of a list of scalars": "c:\n  <<: [{a: 1}, 1]\n",
+    "merge of an aliased list": "l: &l [{a: 1}, {b: 2}]\nc: {<<: *l}\n",
+    "merge twice": "c: {<<: {a: 1}, <<: {b: 1}}\n",
+    "merge after an empty list": "<<: []\n<<: {p: 1}\n",
+    "anchored scalar": "a: &x 1\nb: *x\nc: &t true\nd: &s hi\ne: &n ~\nf: &f 1.5\ng: *t\n",
+    "aliased scalar key": "a: &k b\n*k : 1\n",
+    "reused anchor": "a: &x [1]\nb: &x [2]\nc: *x\n",
+    "undefined alias": "a: *nowhere\n",
+    "timestamp": "a: 2024-01-01\nb: 2024-01-01 10:00:00\n",
+    "hex integer": "a: 0x1F\nb: 0o17\nc: 0b11\n",
+    "underscores": "a: 1_000.5\nb: 1_000\n",
+    "value key": "=: a\nb: =\n",
+    "two documents": "a: 1\n---\nb: 2\n",
+    "duplicates with an alias": "a: &m [1]\nb: {c: 1, c: 2}\nd: *m\n",
+    "duplicates in a shared mapping": "a: &m {c: 1, c: 2}\nb: [*m, *m]\n",
+    "duplicates in a merged mapping": "a: {<<: {c: 1, c: 2}, d: 1}\n",
+    "duplicates dropped from the tree": "a: {c: {x: 1, x: 2}}\na: {d: {y: 1, y: 2}}\n",
+    "tabs in flow and comments": "a: [1,\t2]\nb: {c:\t1} #\tnote\nc: 'x\ty'\nd: |\n  x\ty\n",
+    "integer too long, merged": "a: &a {x: " + "7" * 5000 + "}\nb: {<<: *a}\n",
+}
+
+
+@pytest.mark.parametrize("name", sorted(FEATURES))
+def test_libyaml_reads_every_feature_as_ruamel_reads_it(name: str) -> None:
+    text = FEATURES[name]
+    try:
+        yaml_tree.read_libyaml(text)
+    except Exception as error:  # one of ruamel's errors, raised as ruamel raises it
+        assert not isinstance(error, (Unsupported, Refused)), error
+    with warnings.catch_warnings(record=True) as fast_warnings:
+        warnings.simplefilter("always")
+        found = diagnostics(text)
+    with warnings.catch_warnings(record=True) as reference_warnings:
+        warnings.simplefilter("always")
+        reference = _reference_diagnostics(text)
+    assert found == reference
+    assert [str(w.message) for w in fast_warnings] == [str(w.message) for w in reference_warnings]
+    if not reference:
+        assert_same_document(yaml_tree.read(text), yaml_tree.read_ruamel(text))
+
+
+def _outcome(read: Any, text: str) -> Any:
+    """``read(text)``, or the name of the exception it raises (ruamel fails on some documents,
+    such as a ``!!set`` merged into a mapping; the fast reading leaves those to it)."""
+    try:
+        return read(text)
+    except Exception as error:
+        return type(error).__name__
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_generated_documents_read_as_ruamel_reads_them(seed: int) -> None:
+    """Random documents mixing every feature (``yaml_documents``): the same diagnostics, and
+    the same tree when ruamel reads one; most of them read by libyaml."""
+    taken = 0
+    texts = documents(60, seed)
+    for text in texts:
+        try:
+            yaml_tree.read_libyaml(text)
+            taken += 1
+        except Unsupported:
+            pass
+        except Exception:  # an error, compared below
+            taken += 1
+        assert _outcome(diagnostics, text) == _outcome(_reference_diagnostics, text), text
+        try:
+            reference = yaml_tree.read_ruamel(text)
+        except Exception:
+            continue
+        assert_same_document(yaml_tree.read(text), reference)
+    assert taken >= 0.85 * len(texts)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a:\t1\n",
+        "a: 1\t\nb: 2\t# c\n",
+        "a: &x\t1\nb:\t*x\n",
+        "a: !!int\t1\n",
+        "a:\n  - 1\n  - {b:\t[2,\t3]}\nc:\t'q\tr'\n",
+        "a: 1\n  \t\nb: 2\n",
+    ],
+)
+def test_tabs_are_read_where_yaml_allows_them(text: str) -> None:
+    """A tab between tokens on a line, which ruamel refuses outside flow collections: read as
+    ruamel reads the text with a space there (tabs within scalars kept)."""
+    spaced = text.replace(":\t", ": ").replace(",\t", ", ").replace("\t#", " #")
+    spaced = spaced.replace("\t\n", " \n").replace("&x\t", "&x ").replace("!!int\t", "!!int ")
+    fast = yaml_tree.read_libyaml(text)
+    assert not diagnostics(text)
+    assert fast is not None and fast.root
+    reference = yaml_tree.read_ruamel(spaced)
+    assert_same_document(fast, reference)
+
+
+def test_a_tab_within_a_plain_scalar_is_kept() -> None:
+    document = yaml_tree.read_libyaml("a: x\ty\nb: [c\td]\n")
+    assert document is not None and document.root == {"a": "x\ty", "b": ["c\td"]}
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a:\n\tb: 1\n",
+        "a:\t1\nb:\n\t- 2\n",
+        "a:\t[1,\t2\nb: 3\n",
+        "a: 'x\ty'\nb:\t{c: 1\n",
+    ],
+)
+def test_a_syntax_error_after_tabs_yaml_allows_is_worded_where_it_is(text: str) -> None:
+    """ruamel words the error libyaml finds, not a tab before it that libyaml read."""
+    found = diagnostics(text)
+    assert len(found) == 1 and ": error: not valid YAML: " in found[0]
+    untabbed = text[: text.index("\n", text.index("\n") + 1)].replace(":\t", ": ")
+    untabbed = untabbed.replace(",\t", ", ") + text[len(untabbed) :]
+    assert found == _reference_diagnostics(untabbed)
+
+
+def test_an_unsupported_yaml_version_is_an_error_not_a_crash() -> None:
+    """ruamel's reading fails on an assertion for %YAML 1.0 or 1.3."""
+    for version in ("1.0", "1.3"):
+        assert diagnostics(f"%YAML {version}\n---\na: 1\n") == [
+            f"f.yaml:1:1: error: not valid YAML: found YAML version {version}, which is not "
+            "supported; expected %YAML 1.1 or %YAML 1.2"
+        ]
+
+
+@pytest.mark.parametrize("feature", ["anchors", "merges", "tags", "directives", "tabs"])
+def test_big_files_using_each_feature_are_read_by_libyaml(
+    monkeypatch: pytest.MonkeyPatch, feature: str
+) -> None:
+    """A 100 kB problem using the feature on every line is read without ruamel (whose reading
+    of it takes seconds: ``benchmarks/big_inputs.py --files``) and checks; a small one reads as
+    ruamel reads it."""
+    small = featured(30, feature)
+    if feature != "tabs":  # ruamel refuses a tab after a colon in block context
+        assert_same_document(yaml_tree.read(small), yaml_tree.read_ruamel(small))
+    text = featured(1000, feature)
+    assert len(text) > 60_000
+
+    def refuse(text: str) -> None:
+        raise AssertionError("read by ruamel")
+
+    monkeypatch.setattr(yaml_tree, "read_ruamel", refuse)
+    problem, found = check_problem_text(text, "big.yaml")
+    assert problem is not None and len(problem.objects) == 1000, found
+
+
+# ---------------------------------------------------------------------------------------------
 # what libyaml leaves to ruamel
 # ---------------------------------------------------------------------------------------------
 LEFT_TO_RUAMEL = {
-    "directive": "%YAML 1.1\n---\na: yes\n",
-    "tag directive": "%TAG !e! tag:example.com,2000:\n---\na: !e!x 1\n",
-    "explicit tag": "a: !!str 1\nb: !!float 2\n",
-    "local tag": "a: !thing 1\n",
-    "non-specific tag": "a: ! 1\n",
-    "tagged collection": "a: !!set {x, y}\nb: !!omap [c: 1]\n",
-    "merge key": "base: &b {x: 1, y: 2}\nc:\n  <<: *b\n  y: 3\n",
-    "anchored scalar": "a: &x 1\nb: *x\nc: &t true\n",
-    "reused anchor": "a: &x [1]\nb: &x [2]\nc: *x\n",
-    "undefined alias": "a: *nowhere\n",
     "recursive alias": "a: &x [1, *x]\n",
     "alias as key": "a: &k [1]\n? *k\n: 2\n",
     "collection as key": "[1, 2]: a\n",
-    "timestamp": "a: 2024-01-01\n",
-    "hex integer": "a: 0x1F\n",
-    "underscores": "a: 1_000.5\n",
-    "value key": "=: a\n",
-    "tab": "a:\t1\n",
     "NEL": "a: 'x\x85y'\n",
     "line separator": "a: 'x\u2028y'\n",
     "byte-order mark": "a: '\ufeff'\n",
     "control character": "a: '\x07'\n",
-    "two documents": "a: 1\n---\nb: 2\n",
     "deep nesting": "a: " + "[" * 70 + "]" * 70 + "\n",
-    "duplicates with an alias": "a: &m [1]\nb: {c: 1, c: 2}\nd: *m\n",
+    "alias out of a tagged collection": "a: &x [1]\nb: !thing [*x]\n",
+    "several errors": "a: {<<: 1}\nb: {<<: 2}\n",
 }
 
 
