@@ -16,7 +16,6 @@ Drawn with the scene layers of :mod:`arrange_up.figures.scene`, like a plan's st
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +29,7 @@ from arrange_up.figures.scene import (
     draw_action,
     draw_scene,
     legend_handles,
+    panel_grid,
     scene_at,
     style_axes,
 )
@@ -76,10 +76,8 @@ def draw_episode(
     replanned = {r.after for r in outcome.replans}
     plt = pyplot()
     panels = len(steps) + 1
-    columns = max(1, min(columns, panels))
-    rows = math.ceil(panels / columns)
+    rows, columns, scale = panel_grid(problem, panels, columns)
     width, depth = problem.table.size
-    scale = 3.6 / max(width, depth)
     fig, axes = plt.subplots(
         rows,
         columns,

@@ -299,6 +299,14 @@ def describe(action: Action, problem: ArrangementProblem) -> str:
     return f"pick {action.obj}"
 
 
+def panel_grid(problem: ArrangementProblem, panels: int, columns: int) -> tuple[int, int, float]:
+    """The grid of a storyboard of ``panels`` table panels at most ``columns`` wide:
+    ``(rows, columns, scale)``, ``scale`` the figure inches per table unit that draws the
+    table's longer side 3.6 in long."""
+    columns = max(1, min(columns, panels))
+    return math.ceil(panels / columns), columns, 3.6 / max(problem.table.size)
+
+
 def style_axes(ax: Axes, problem: ArrangementProblem, *, fontsize: float = 7) -> None:
     """Equal-aspect axes around the table, ticked and labelled in the problem's length unit
     (the figures draw in inches; the ticks are placed at round values of the user's unit)."""

@@ -19,7 +19,6 @@ legend below the panels says which layer is which, the axes are in the problem's
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -32,6 +31,7 @@ from arrange_up.figures.scene import (
     draw_scene,
     has_shadows,
     legend_handles,
+    panel_grid,
     prediction_label,
     scene_at,
     style_axes,
@@ -134,10 +134,8 @@ def draw_storyboard(
     )
     plt = pyplot()
     panels = len(actions) + 1
-    columns = max(1, min(columns, panels))
-    rows = math.ceil(panels / columns)
+    rows, columns, scale = panel_grid(problem, panels, columns)
     width, depth = problem.table.size
-    scale = 3.6 / max(width, depth)
     fig, axes = plt.subplots(
         rows,
         columns,
