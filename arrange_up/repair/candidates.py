@@ -338,7 +338,9 @@ def choose(
 
     ``rejects`` (when given) says why a candidate may not win (empty when it may): the repair
     rejects a candidate whose plan is no longer a nominal plan. It is asked lazily, best
-    candidate first, until the best bare push and the best fixture it accepts are found.
+    candidate first, until the best bare push and the best fixture it accepts are found. The
+    fixture must beat the best accepted bare push or, when no bare push is accepted, the best
+    bare push: ``None`` when it does not.
     """
     if not valid:
         return None
@@ -349,14 +351,19 @@ def choose(
                 return c
         return None
 
-    best_bare = best([c for c in valid if c.fixture is None or not c.reachable])
+    bare = [c for c in valid if c.fixture is None or not c.reachable]
+    best_bare = best(bare)
     best_fixed = best([c for c in valid if c.fixture is not None and c.reachable])
     if best_fixed is None:
         return best_bare
-    if best_bare is None:
+    # the bar a fixture must clear is the best bare push; when ``rejects`` refuses every bare
+    # push, still the best of them: a fixture that scores worse than pushing without it is
+    # never placed (no candidate wins then)
+    reference = best_bare or min(bare, key=lambda c: (c.distance, c.multiplier), default=None)
+    if reference is None:
         return best_fixed
-    gain = best_bare.distance - best_fixed.distance
-    if gain > max(MIN_FIXTURE_GAIN[0], MIN_FIXTURE_GAIN[1] * best_bare.distance):
+    gain = reference.distance - best_fixed.distance
+    if gain > max(MIN_FIXTURE_GAIN[0], MIN_FIXTURE_GAIN[1] * reference.distance):
         return best_fixed
     return best_bare
 

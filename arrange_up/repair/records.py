@@ -111,7 +111,8 @@ class StepRecord:
                 push,
                 (),
                 status=StepStatus.FAILED,
-                reason="every valid candidate would make the plan fail nominally (no fixture "
+                reason="every valid candidate would make the plan fail nominally, or is a "
+                "fixture scoring worse than the bare push (no fixture "
                 f"and {len(placements) - common['blocked']} placements, multipliers "
                 f"{', '.join(f'{m:g}' for m in MULTIPLIERS)}): " + "; ".join(reasons),
                 **common,

@@ -301,6 +301,11 @@ def test_the_choice_skips_candidates_the_repair_rejects():
     assert candidates.choose([bare, longer, near, far], rejects) is far
     assert asked == [longer, bare, near, far]  # best first, and no further than needed
     assert candidates.choose([bare, longer], lambda c: "no") is None
+    # no bare push accepted: a fixture still has to beat the best bare push, or nothing wins
+    no_bare = lambda c: "misses the goal" if c.fixture is None else ""  # noqa: E731
+    assert candidates.choose([bare, longer, far], no_bare) is far  # 0.4 beats 0.5
+    worse = rp.Candidate("bar", (3.0, 1.0, 0.0), 1.0, "ok", 0.6, push=push)
+    assert candidates.choose([bare, longer, worse], no_bare) is None
 
 
 def test_the_repair_keeps_the_plan_nominal_while_choosing():
