@@ -297,10 +297,13 @@ class PlanGuard:
     ``nominal`` is the deterministic semantics' belief after the repaired steps before
     ``index``. A candidate is *rejected* (its reason returned, empty otherwise) when its
     actions followed by the nominal plan's remaining actions, run in the deterministic
-    semantics, make an action fail or (with ``goal``) end outside the goal. Checked once per
-    candidate key; ``rejected`` keeps every refusal. Since every step's choice passes it, the
-    repaired prefix and the rest of the nominal plan stay a nominal plan after every step, and
-    the finished repair reaches the goal nominally.
+    semantics, make an action fail or (with ``goal``) end outside the goal. When the next
+    nominal action is a push and ``lookahead`` is set (the one-step problem sets it), that push
+    is run as the next step's repair will first try it, which only the candidate's outcome on
+    the belief tells (``lookahead(candidate, push)``: backed off the parts of that outcome),
+    so that a choice does not leave the next step without a valid bare push. ``rejected``
+    keeps every candidate's last refusal. Since every step's choice passes the check, the
+    finished repair reaches the goal nominally.
     """
 
     def __init__(
@@ -316,26 +319,31 @@ class PlanGuard:
         self.index = index
         self.rest = [(k, (a,)) for k, a in enumerate(actions) if k > index]
         self.goal = goal
+        self.lookahead: Callable[[Candidate, Push], Push] | None = None
         self.checked: dict[Key, str] = {}
+        self._runs: dict[tuple[Any, ...], str] = {}
 
     def __call__(self, c: Candidate) -> str:
-        key = (c.fixture, c.pose, c.multiplier)
-        if key in self.checked:
-            return self.checked[key]
+        group = c.actions()
         if c.fixture is not None and c.pose is not None and c.push is not None:
             # a fixture the nominal push does not reach leaves its outcome that of the bare
-            # push (the same simulated bodies), and it is picked up again: the same verdict
+            # push (the same simulated bodies), and it is picked up again: the same run
             placed, _ = self.replay.apply(self.nominal, (Place(c.fixture, c.pose),))
             model = self.replay.model
             if placed is not None and c.fixture not in model.affected_objects(
                 placed.intervals, c.push
             ):
-                self.checked[key] = self(replace(c, fixture=None, pose=None))
-        if key not in self.checked:
-            self.checked[key] = self.replay.shortfall(
-                self.nominal, [(self.index, c.actions()), *self.rest], goal=self.goal
+                group = (c.push,)
+        rest = self.rest
+        if self.lookahead is not None and rest and isinstance(rest[0][1][0], Push):
+            rest = [(rest[0][0], (self.lookahead(c, rest[0][1][0]),)), *rest[1:]]
+        run = (group, rest[0][1] if rest else ())
+        if run not in self._runs:
+            self._runs[run] = self.replay.shortfall(
+                self.nominal, [(self.index, group), *rest], goal=self.goal
             )
-        return self.checked[key]
+        self.checked[(c.fixture, c.pose, c.multiplier)] = self._runs[run]
+        return self._runs[run]
 
     @property
     def rejected(self) -> tuple[tuple[Key, str], ...]:
@@ -638,6 +646,8 @@ class Repairer:
                 )
 
         problem = _OneStepProblem(self, belief, step, push, nominal_next)
+        if guard is not None:
+            guard.lookahead = problem.next_push
         # 1. swath from the no-fixture push at the selection multiplier (every particle)
         swaths = problem.swaths()
         grid = problem.grid(swaths)
@@ -727,6 +737,17 @@ class _OneStepProblem:
         push = self.push
         distance = round_pose_value(push.distance * multiplier + self.backoff)
         return Push(push.manipulator, self.approach, distance)
+
+    def next_push(self, c: Candidate, push: Push) -> Push:
+        """The next nominal ``push`` as the next step's repair first tries it after candidate
+        ``c``: backed off the parts of ``c``'s outcome on the belief (as given while that
+        outcome is not simulated, or failed)."""
+        outcome = self.outcomes.get((c.fixture, c.pose, c.multiplier))
+        if outcome is None or outcome.belief is None:
+            return push
+        r = self.repairer
+        approach, backoff = clear_approach(r.problem, r.checker, r.intervals(outcome.belief), push)
+        return Push(push.manipulator, approach, round_pose_value(push.distance + backoff))
 
     def swaths(self) -> tuple[Swath, ...]:
         """The part motion swaths of the no-fixture push at the selection multiplier, whose
