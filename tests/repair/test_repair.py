@@ -350,6 +350,24 @@ def test_a_plan_guard_rejects_a_push_that_overshoots_the_goal(down_push):
         replay.close()
 
 
+def test_the_plan_guard_runs_the_next_push_as_its_lookahead_gives_it(tz):
+    from arrange_up.repair.nominal import NominalReplay
+    from arrange_up.repair.repairer import PlanGuard
+
+    nominal = rp.nominal_plans(tz, 1, seed=0)[0]
+    assert len(nominal) == 2 and all(isinstance(a, Push) for a in nominal)
+    replay = NominalReplay(tz)
+    try:
+        as_planned = rp.Candidate(None, None, 1.0, "ok", 0.0, push=nominal[0])
+        guard = PlanGuard(replay, replay.initial(), 0, nominal, True)
+        assert guard(as_planned) == ""  # the nominal plan itself
+        guard = PlanGuard(replay, replay.initial(), 0, nominal, True)
+        guard.lookahead = lambda c, push: Push(push.manipulator, push.pose, 0.5 * push.distance)
+        assert guard(as_planned)  # the next push, so run, stops short of the goal
+    finally:
+        replay.close()
+
+
 def test_belief_intervals_span_angles_the_short_way(tz):
     # Z (symmetry period 180 deg) starts at 90 deg +- 1 deg: its canonical angle period is
     # centred on that start, so its interval is +-1 deg, not the whole period
