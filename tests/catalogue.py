@@ -125,6 +125,29 @@ goal:
   poses: {A: [5, 0.5, 0]}
 uncertainty: {place: [0.2, 0.2, 15], push: [0.05, 0.05, 3]}
 """,
+    # The tutorial's problem (docs/tutorial.md): an L and a box into a walled corner, with a
+    # fixture; a fixture or a longer push chosen for the belief can make its nominal plan miss.
+    "ell-and-box": """
+name: ell-and-box
+table: {size: [8, 5], walls: [left, right, bottom, top]}
+shapes:
+  ell:
+    polygon: [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
+objects:
+  L: {kind: part, shape: ell}
+  B: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+  bar: {kind: fixture, shape: {box: [2, 0.5]}}
+initial:
+  L: {pose: [2.5, 2.5, 0], uncertainty: [0.2, 0.2, 10]}
+goal:
+  tolerance: [0.2, 0.2, 15]
+  poses: {L: [6.83, 0.83, 0], B: [7.5, 1.5, 0]}
+uncertainty:
+  place: [0.2, 0.2, 15]
+  push: [0.05, 0.05, 3]
+  friction: [0.25, 0.55]
+""",
 }
 
 NAMES: tuple[str, ...] = tuple(TEXTS)

@@ -132,7 +132,9 @@ class StepScores:
     when every candidate is invalid). ``swaths`` holds ``(part, (xmin, ymin, xmax, ymax))``.
     ``backoff`` is how far the push's approach pose was moved back along the push (its
     distance grown by as much) so that its approach shadow clears the belief's shadows; 0 when
-    it already did.
+    it already did. ``rejected`` holds the valid candidates (by key) that the repair checked in
+    the deterministic semantics and refused, with why: with them the plan would no longer
+    reach the goal nominally, or a later action would fail.
     """
 
     step: int
@@ -150,6 +152,7 @@ class StepScores:
     simulations: int
     elapsed: float
     after: ParticleBelief | None = field(default=None, repr=False, compare=False)
+    rejected: tuple[tuple[Key, str], ...] = ()
 
     @property
     def no_fixture(self) -> Candidate:
@@ -325,22 +328,41 @@ def stage_candidates(
     return normalise(out)
 
 
-def choose(valid: list[Candidate]) -> Candidate | None:
+def choose(
+    valid: list[Candidate], rejects: Callable[[Candidate], str] | None = None
+) -> Candidate | None:
     """The winner among valid candidates: the smallest distance (ties: the smaller
     multiplier), except that a fixture must beat the best bare push by
-    :data:`MIN_FIXTURE_GAIN`."""
+    :data:`MIN_FIXTURE_GAIN`.
+
+    ``rejects`` (when given) says why a candidate may not win (empty when it may): the repair
+    rejects a candidate whose plan is no longer a nominal plan. It is asked lazily, best
+    candidate first, until the best bare push and the best fixture it accepts are found. The
+    fixture must beat the best accepted bare push or, when no bare push is accepted, the best
+    bare push: ``None`` when it does not.
+    """
     if not valid:
         return None
+
+    def best(group: list[Candidate]) -> Candidate | None:
+        for c in sorted(group, key=lambda c: (c.distance, c.multiplier)):
+            if rejects is None or not rejects(c):
+                return c
+        return None
+
     bare = [c for c in valid if c.fixture is None or not c.reachable]
-    fixed = [c for c in valid if c.fixture is not None and c.reachable]
-    best_bare = min(bare, key=lambda c: (c.distance, c.multiplier), default=None)
-    best_fixed = min(fixed, key=lambda c: (c.distance, c.multiplier), default=None)
+    best_bare = best(bare)
+    best_fixed = best([c for c in valid if c.fixture is not None and c.reachable])
     if best_fixed is None:
         return best_bare
-    if best_bare is None:
+    # the bar a fixture must clear is the best bare push; when ``rejects`` refuses every bare
+    # push, still the best of them: a fixture that scores worse than pushing without it is
+    # never placed (no candidate wins then)
+    reference = best_bare or min(bare, key=lambda c: (c.distance, c.multiplier), default=None)
+    if reference is None:
         return best_fixed
-    gain = best_bare.distance - best_fixed.distance
-    if gain > max(MIN_FIXTURE_GAIN[0], MIN_FIXTURE_GAIN[1] * best_bare.distance):
+    gain = reference.distance - best_fixed.distance
+    if gain > max(MIN_FIXTURE_GAIN[0], MIN_FIXTURE_GAIN[1] * reference.distance):
         return best_fixed
     return best_bare
 

@@ -59,7 +59,8 @@ class StepRecord:
     place or pick). For a push: the chosen ``fixture``, ``pose`` and ``multiplier``, the chosen
     candidate's ``distance`` and the bare nominal push's (``nominal_distance``, multiplier 1,
     ``inf`` if invalid), the approach ``backoff`` (see :class:`StepScores`) and candidate
-    counts. ``status`` is ``"ok"`` or ``"failed"``.
+    counts (``rejected``: valid candidates refused because the plan would no longer be a
+    nominal plan with them). ``status`` is ``"ok"`` or ``"failed"``.
     """
 
     index: int
@@ -78,6 +79,7 @@ class StepRecord:
     blocked: int = 0
     invalid: int = 0
     unreachable: int = 0
+    rejected: int = 0
     selection_multiplier: float | None = None
     backoff: float = 0.0
     simulations: int = 0
@@ -94,12 +96,27 @@ class StepRecord:
             "blocked": sum(1 for c in placements if c.status == BLOCKED),
             "invalid": sum(1 for c in scores.placements if c.status == INVALID),
             "unreachable": sum(1 for c in placements if not c.reachable),
+            "rejected": len(scores.rejected),
             "selection_multiplier": scores.selection_multiplier,
             "backoff": scores.backoff,
             "nominal_distance": bare.distance,
             "simulations": scores.simulations,
             "elapsed": scores.elapsed,
         }
+        if best is None and any(c.valid for c in scores.refined):
+            reasons = sorted({why for _, why in scores.rejected})
+            return cls(
+                index,
+                "push",
+                push,
+                (),
+                status=StepStatus.FAILED,
+                reason="every valid candidate would make the plan fail nominally, or is a "
+                "fixture scoring worse than the bare push (no fixture "
+                f"and {len(placements) - common['blocked']} placements, multipliers "
+                f"{', '.join(f'{m:g}' for m in MULTIPLIERS)}): " + "; ".join(reasons),
+                **common,
+            )
         if best is None:
             reasons = sorted({c.reason for c in scores.refined if c.reason})
             return cls(
@@ -164,6 +181,7 @@ class StepRecord:
                 blocked=self.blocked,
                 invalid=self.invalid,
                 unreachable=self.unreachable,
+                rejected=self.rejected,
                 simulations=self.simulations,
                 elapsed=json_round(self.elapsed),
             )

@@ -48,7 +48,8 @@ failure, never a silently unreliable plan.
    score ``None``, left out of the min-max normalisation of the others' scores to [0, 1]
    (0 is best). When no candidate is valid at 2x, the selection falls back to the next smaller
    multiplier.
-4. *Push distance* (OPTIMIZEPUSHDISTANCE): the best :data:`REFINE` placements and "no fixture"
+4. *Push distance* (OPTIMIZEPUSHDISTANCE): the best :data:`REFINE` placements (of those that
+   keep the plan nominal at some multiplier, item 6) and "no fixture"
    are simulated at every multiplier of :data:`MULTIPLIERS` (1, 1.25, 1.5, 1.75, 2; the push
    keeps its approach pose, only its distance grows) and the pair with the smallest distance
    wins (ties: the smaller multiplier). A fixture must beat the best bare push by more than
@@ -58,6 +59,14 @@ failure, never a silently unreliable plan.
    guards against a placement that is best at 2x only.
 5. The push becomes ``place(fixture, pose), push(distance * multiplier), pick(fixture)``, or
    ``push(distance * multiplier)`` without a fixture.
+6. *The plan stays a nominal plan* (:class:`PlanGuard`). A candidate may be refined or win
+   only if the repaired steps so far, its own actions and the nominal plan's remaining
+   actions, run in the deterministic semantics, leave every action applicable and (when the
+   given plan reaches the goal) reach the goal. Candidates are checked lazily, best first, so
+   the winner is the best candidate on the belief that keeps the plan valid; a step whose
+   valid candidates all break it fails, naming why. Scoring the belief alone, a fixture or a
+   longer push that stops the particles' spread could also move the nominal trajectory out of
+   the goal, and the repair only found out at the end.
 
 Noise and work sharing
 ======================
@@ -91,11 +100,11 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief, ObjectInterval, ParticleBelief
 from arrange_up.geometry import shapes as geometry
 from arrange_up.model.problem import ArrangementProblem, Pose
@@ -104,6 +113,7 @@ from arrange_up.repair.candidates import (
     MULTIPLIERS,
     REFINE,
     SELECTION_MULTIPLIER,
+    Candidate,
     Key,
     Outcome,
     StepScores,
@@ -119,6 +129,7 @@ from arrange_up.repair.candidates import (
     round_pose_value,
     stage_candidates,
 )
+from arrange_up.repair.nominal import NominalReplay
 from arrange_up.repair.records import (
     FAILED,
     SOLVED,
@@ -177,9 +188,11 @@ def repair_plan(
         multipliers. Comparing its plan with the full repair's measures what the fixtures
         themselves bring. Recorded as ``fixtures`` in the result and its plan document.
 
-    A repaired plan must reach the goal in the deterministic semantics: one that does not (an
-    empty nominal plan, or one short of the goal that no fixture saves) ends with status
-    ``"failed"`` and a ``reason`` naming the parts that miss it.
+    A repaired plan must reach the goal in the deterministic semantics. When the nominal plan
+    does, every step keeps only candidates with which it still does (see the module
+    docstring, item 6); a nominal plan that does not (an empty plan, or one short of the goal)
+    is repaired as it is and ends with status ``"failed"`` and a ``reason`` naming the parts
+    that miss the goal.
     Raises ``ValueError`` for bad arguments, or a nominal plan that fails in the deterministic
     semantics (it is not a nominal plan of ``problem``).
     """
@@ -209,14 +222,27 @@ def repair_plan(
 
     try:
         states = repairer.nominal_states(actions)
+        # the plan must stay a nominal plan step by step: applicable, and reaching the goal
+        # when the given plan does (a plan short of the goal is repaired as it is, and fails
+        # at the end)
+        reaches_goal = not repairer.replay.goal_miss(states[-1])
+        nominal = repairer.replay.initial()
         belief = repairer.initial_belief()
         beliefs = [belief]
         for index, action in enumerate(actions):
             step_started = time.monotonic()
             sims_before = repairer.simulations
             if isinstance(action, Push):
+                guard = PlanGuard(repairer.replay, nominal, index, actions, reaches_goal)
                 scores = repairer.one_step(
-                    belief, index, action, states[index], states[index + 1], progress, len(actions)
+                    belief,
+                    index,
+                    action,
+                    states[index],
+                    states[index + 1],
+                    progress,
+                    len(actions),
+                    guard=guard,
                 )
                 record = StepRecord.of_push(index, action, scores)
                 after = scores.after
@@ -239,6 +265,9 @@ def repair_plan(
             out.extend(record.actions)
             belief = after
             beliefs.append(belief)
+            nominal, why = repairer.replay.apply(nominal, record.actions)
+            if nominal is None:  # the guard of the last push ran these very actions
+                raise RuntimeError(f"step {index + 1} fails nominally after its check: {why}")
             if progress is not None:
                 progress(
                     {
@@ -251,7 +280,7 @@ def repair_plan(
                         "choice": record.describe_choice(problem),
                     }
                 )
-        missed = nominal_goal_miss(problem, repairer.nominal_states(out)[-1])
+        missed = repairer.replay.goal_miss(nominal.particles[0])
         if missed:
             reason = f"the repaired plan does not reach the goal nominally: {missed}"
             return result(FAILED, None, reason, beliefs)
@@ -262,15 +291,63 @@ def repair_plan(
         repairer.close()
 
 
-def nominal_goal_miss(problem: ArrangementProblem, state: WorldState) -> str:
-    """Which parts ``state`` leaves outside the goal, as a phrase (empty when none)."""
-    misses = GoalTest(problem).misses(state)
-    return ", ".join(
-        f"{m.part} is not on the table"
-        if m.missing
-        else f"{m.part} misses its goal in " + "/".join(m.dimensions())
-        for m in misses
-    )
+class PlanGuard:
+    """Whether a candidate of nominal step ``index`` keeps the repaired plan a nominal plan.
+
+    ``nominal`` is the deterministic semantics' belief after the repaired steps before
+    ``index``. A candidate is *rejected* (its reason returned, empty otherwise) when its
+    actions followed by the nominal plan's remaining actions, run in the deterministic
+    semantics, make an action fail or (with ``goal``) end outside the goal. When the next
+    nominal action is a push and ``lookahead`` is set (the one-step problem sets it), that push
+    is run as the next step's repair will first try it, which only the candidate's outcome on
+    the belief tells (``lookahead(candidate, push)``: backed off the parts of that outcome),
+    so that a choice does not leave the next step without a valid bare push. ``rejected``
+    keeps every candidate's last refusal. Since every step's choice passes the check, the
+    finished repair reaches the goal nominally.
+    """
+
+    def __init__(
+        self,
+        replay: NominalReplay,
+        nominal: ParticleBelief,
+        index: int,
+        actions: Sequence[Action],
+        goal: bool,
+    ) -> None:
+        self.replay = replay
+        self.nominal = nominal
+        self.index = index
+        self.rest = [(k, (a,)) for k, a in enumerate(actions) if k > index]
+        self.goal = goal
+        self.lookahead: Callable[[Candidate, Push], Push] | None = None
+        self.checked: dict[Key, str] = {}
+        self._runs: dict[tuple[Any, ...], str] = {}
+
+    def __call__(self, c: Candidate) -> str:
+        group = c.actions()
+        if c.fixture is not None and c.pose is not None and c.push is not None:
+            # a fixture the nominal push does not reach leaves its outcome that of the bare
+            # push (the same simulated bodies), and it is picked up again: the same run
+            placed, _ = self.replay.apply(self.nominal, (Place(c.fixture, c.pose),))
+            model = self.replay.model
+            if placed is not None and c.fixture not in model.affected_objects(
+                placed.intervals, c.push
+            ):
+                group = (c.push,)
+        rest = self.rest
+        if self.lookahead is not None and rest and isinstance(rest[0][1][0], Push):
+            rest = [(rest[0][0], (self.lookahead(c, rest[0][1][0]),)), *rest[1:]]
+        run = (group, rest[0][1] if rest else ())
+        if run not in self._runs:
+            self._runs[run] = self.replay.shortfall(
+                self.nominal, [(self.index, group), *rest], goal=self.goal
+            )
+        self.checked[(c.fixture, c.pose, c.multiplier)] = self._runs[run]
+        return self._runs[run]
+
+    @property
+    def rejected(self) -> tuple[tuple[Key, str], ...]:
+        return tuple((key, why) for key, why in self.checked.items() if why)
 
 
 def step_scores(
@@ -317,12 +394,20 @@ def step_scores(
     try:
         states = repairer.nominal_states(nominal)
         belief = repairer.initial_belief()
+        deterministic = repairer.replay.initial()
         for k in range(step - 1):
             after, reason = repairer.propagate(belief, k, groups[k])
             if after is None:
                 raise ValueError(f"the belief cannot be propagated through step {k + 1}: {reason}")
             belief = after
-        return repairer.one_step(belief, step - 1, push, states[step - 1], states[step])
+            deterministic, reason = repairer.replay.apply(deterministic, groups[k])
+            if deterministic is None:
+                raise ValueError(f"step {k + 1} fails in the deterministic semantics: {reason}")
+        goal = not repairer.replay.goal_miss(states[-1])
+        guard = PlanGuard(repairer.replay, deterministic, step - 1, nominal, goal)
+        return repairer.one_step(
+            belief, step - 1, push, states[step - 1], states[step], guard=guard
+        )
     finally:
         repairer.close()
 
@@ -367,6 +452,7 @@ class Repairer:
         self.frame = self.semantics.frame
         self.simulations = 0
         self.parts = tuple(spec.name for spec in problem.parts)
+        self.replay = NominalReplay(problem)
         self._intervals: dict[int, tuple[ParticleBelief, IntervalBelief]] = {}
 
     # -- setup ---------------------------------------------------------------------------------
@@ -395,6 +481,7 @@ class Repairer:
 
     def close(self) -> None:
         self.semantics.close()
+        self.replay.close()
 
     def _check_time(self) -> None:
         if self.deadline is not None and time.monotonic() >= self.deadline:
@@ -534,8 +621,14 @@ class Repairer:
         nominal_next: WorldState,
         progress: ProgressCallback | None = None,
         steps: int = 0,
+        *,
+        guard: PlanGuard | None = None,
     ) -> StepScores:
-        """ONESTEPFIXTUREPROBLEM (Figure 4-6) for ``push`` from ``belief``."""
+        """ONESTEPFIXTUREPROBLEM (Figure 4-6) for ``push`` from ``belief``.
+
+        With a ``guard``, only candidates it accepts are refined and may win: the best few
+        placements are the best that keep the plan nominal at some multiplier, and the winner
+        the best candidate that keeps it so (see :class:`PlanGuard`)."""
         started = time.monotonic()
         sims_before = self.simulations
 
@@ -553,6 +646,8 @@ class Repairer:
                 )
 
         problem = _OneStepProblem(self, belief, step, push, nominal_next)
+        if guard is not None:
+            guard.lookahead = problem.next_push
         # 1. swath from the no-fixture push at the selection multiplier (every particle)
         swaths = problem.swaths()
         grid = problem.grid(swaths)
@@ -569,11 +664,19 @@ class Repairer:
         placement_candidates = stage_candidates(
             [(None, None, True)] + grid, selection, problem.outcomes, problem.pushed
         )
-        # 4. multipliers for the best few placements and no fixture
-        ranked = sorted(
+        # 4. multipliers for the best few placements (that keep the plan nominal at some
+        # multiplier) and no fixture
+        ranked: list[Candidate] = []
+        for c in sorted(
             (c for c in placement_candidates if c.valid and c.fixture is not None and c.reachable),
             key=lambda c: c.distance,
-        )[:REFINE]
+        ):
+            if len(ranked) == REFINE:
+                break
+            if guard is None or any(
+                not guard(replace(c, multiplier=m, push=problem.pushed(m))) for m in MULTIPLIERS
+            ):
+                ranked.append(c)
         report("refine", (len(ranked) + 1) * len(MULTIPLIERS))
         refine_keys = [(None, None, m) for m in MULTIPLIERS] + [
             (c.fixture, c.pose, m) for c in ranked for m in MULTIPLIERS
@@ -582,7 +685,7 @@ class Repairer:
         refined = normalise(
             [candidate(key, problem.outcomes[key], problem.pushed(key[2])) for key in refine_keys]
         )
-        best = choose([c for c in refined if c.valid])
+        best = choose([c for c in refined if c.valid], guard)
         after = None
         if best is not None:
             after = problem.outcomes[(best.fixture, best.pose, best.multiplier)].belief
@@ -602,6 +705,7 @@ class Repairer:
             simulations=self.simulations - sims_before,
             elapsed=time.monotonic() - started,
             after=after,
+            rejected=() if guard is None else guard.rejected,
         )
 
 
@@ -633,6 +737,17 @@ class _OneStepProblem:
         push = self.push
         distance = round_pose_value(push.distance * multiplier + self.backoff)
         return Push(push.manipulator, self.approach, distance)
+
+    def next_push(self, c: Candidate, push: Push) -> Push:
+        """The next nominal ``push`` as the next step's repair first tries it after candidate
+        ``c``: backed off the parts of ``c``'s outcome on the belief (as given while that
+        outcome is not simulated, or failed)."""
+        outcome = self.outcomes.get((c.fixture, c.pose, c.multiplier))
+        if outcome is None or outcome.belief is None:
+            return push
+        r = self.repairer
+        approach, backoff = clear_approach(r.problem, r.checker, r.intervals(outcome.belief), push)
+        return Push(push.manipulator, approach, round_pose_value(push.distance + backoff))
 
     def swaths(self) -> tuple[Swath, ...]:
         """The part motion swaths of the no-fixture push at the selection multiplier, whose

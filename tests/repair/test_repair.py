@@ -11,7 +11,7 @@ import json
 import math
 
 import pytest
-from catalogue import servo
+from catalogue import servo, tiny
 from click.testing import CliRunner
 
 import arrange_up.repair as rp
@@ -281,6 +281,91 @@ def test_choice_needs_a_real_gain_for_a_fixture():
         ]
     )
     assert [c.score for c in scored] == [1.0, 0.0, None]
+
+
+def test_the_choice_skips_candidates_the_repair_rejects():
+    push = Push("paddle", (0.0, 0.0, 0.0), 1.0)
+    bare, longer = (
+        rp.Candidate(None, None, m, "ok", d, push=push) for m, d in ((1.0, 1.0), (2.0, 0.5))
+    )
+    near = rp.Candidate("bar", (1.0, 1.0, 0.0), 1.0, "ok", 0.2, push=push)
+    far = rp.Candidate("bar", (2.0, 1.0, 0.0), 1.0, "ok", 0.4, push=push)
+    assert candidates.choose([bare, longer, near, far]) is near
+    asked = []
+
+    def rejects(c):
+        asked.append(c)
+        return "misses the goal" if c in (near, longer) else ""
+
+    # the best accepted fixture still has to beat the best accepted bare push
+    assert candidates.choose([bare, longer, near, far], rejects) is far
+    assert asked == [longer, bare, near, far]  # best first, and no further than needed
+    assert candidates.choose([bare, longer], lambda c: "no") is None
+    # no bare push accepted: a fixture still has to beat the best bare push, or nothing wins
+    no_bare = lambda c: "misses the goal" if c.fixture is None else ""  # noqa: E731
+    assert candidates.choose([bare, longer, far], no_bare) is far  # 0.4 beats 0.5
+    worse = rp.Candidate("bar", (3.0, 1.0, 0.0), 1.0, "ok", 0.6, push=push)
+    assert candidates.choose([bare, longer, worse], no_bare) is None
+
+
+def test_the_repair_keeps_the_plan_nominal_while_choosing():
+    # With 3 particles the belief prefers, for push 2 of the tutorial's nominal plan, a bar and
+    # pushes whose plan misses the goal nominally (the repair used to choose them and fail at
+    # the end); each is now rejected while choosing, and the repair solves.
+    problem = tiny("ell-and-box")
+    nominal = plan(problem, semantics="deterministic", seed=0).actions
+    assert _reaches_goal(problem, nominal)
+    result = rp.repair_plan(problem, nominal, particles=3, seed=0)
+    assert result.solved, result.reason
+    assert _reaches_goal(problem, result.actions)
+    assert sum(s.rejected for s in result.steps) > 0
+    # the heatmap's scores see the same rule: the same choice for the repaired plan's push 2
+    actions, document = result.actions, result.document(problem)
+    scores = rp.step_scores(problem, actions, 2, document=document)
+    assert scores.rejected and (scores.best.fixture, scores.best.pose) == (
+        result.steps[1].fixture,
+        result.steps[1].pose,
+    )
+    for key, why in scores.rejected:
+        assert why, key
+
+
+def test_a_plan_guard_rejects_a_push_that_overshoots_the_goal(down_push):
+    from arrange_up.repair.nominal import NominalReplay
+    from arrange_up.repair.repairer import PlanGuard
+
+    nominal = rp.nominal_plans(down_push, 1, seed=0)[0]
+    replay = NominalReplay(down_push)
+    try:
+        guard = PlanGuard(replay, replay.initial(), 0, nominal, True)
+        push = nominal[0]
+        as_planned = rp.Candidate(None, None, 1.0, "ok", 0.0, push=push)
+        twice = rp.Candidate(
+            None, None, 2.0, "ok", 0.0, push=Push(push.manipulator, push.pose, 2 * push.distance)
+        )
+        assert guard(as_planned) == ""
+        assert guard(twice)  # off the table or past the goal: rejected, with why
+        assert [key for key, _ in guard.rejected] == [(None, None, 2.0)]
+    finally:
+        replay.close()
+
+
+def test_the_plan_guard_runs_the_next_push_as_its_lookahead_gives_it(tz):
+    from arrange_up.repair.nominal import NominalReplay
+    from arrange_up.repair.repairer import PlanGuard
+
+    nominal = rp.nominal_plans(tz, 1, seed=0)[0]
+    assert len(nominal) == 2 and all(isinstance(a, Push) for a in nominal)
+    replay = NominalReplay(tz)
+    try:
+        as_planned = rp.Candidate(None, None, 1.0, "ok", 0.0, push=nominal[0])
+        guard = PlanGuard(replay, replay.initial(), 0, nominal, True)
+        assert guard(as_planned) == ""  # the nominal plan itself
+        guard = PlanGuard(replay, replay.initial(), 0, nominal, True)
+        guard.lookahead = lambda c, push: Push(push.manipulator, push.pose, 0.5 * push.distance)
+        assert guard(as_planned)  # the next push, so run, stops short of the goal
+    finally:
+        replay.close()
 
 
 def test_belief_intervals_span_angles_the_short_way(tz):
