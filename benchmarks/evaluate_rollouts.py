@@ -1,7 +1,7 @@
 """Benchmark of plan evaluation: rollouts per second on 1 and 2 local workers and on Dask.
 
     python benchmarks/evaluate_rollouts.py                      # plans blocks-7 first (~30 s)
-    python benchmarks/evaluate_rollouts.py --plan /tmp/b7.json  # a plan file of blocks-7
+    python benchmarks/evaluate_rollouts.py --plan b7.json  # a plan file of blocks-7
     python benchmarks/evaluate_rollouts.py --no-dask --rollouts 200
 
 Measures, on the same rollouts (same seed), with pool and cluster start-up timed apart:
