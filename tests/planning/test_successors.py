@@ -9,6 +9,7 @@ import os
 
 import numpy as np
 import pytest
+from test_parallel import _die_once
 
 import arrange_up
 from arrange_up import parallel
@@ -18,7 +19,6 @@ from arrange_up.model.world import WorldState
 from arrange_up.parallel import get_runner
 from arrange_up.planning import successors
 from arrange_up.planning.planner import plan
-from tests.test_parallel import _die_once
 
 
 def _outcome(result) -> tuple:
