@@ -21,7 +21,7 @@ from arrange_up.belief.goals import PartMiss
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
-from arrange_up.parallel import get_runner
+from arrange_up.parallel import SerialRunner, get_runner
 from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
 from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_first_search
@@ -247,7 +247,8 @@ def plan(
         LocalCluster of ``workers`` processes or the cluster at ``scheduler``. The workers
         compute the successors the search will evaluate next while it deals with the current
         one (:mod:`arrange_up.planning.successors`); the plan and the statistics do not depend
-        on where they run. Raises :class:`~arrange_up.parallel.BackendUnavailableError` when
+        on where they run. A semantics that simulates no pushes (``cbst``) always computes
+        them in this process. Raises :class:`~arrange_up.parallel.BackendUnavailableError` when
         dask is missing or the scheduler cannot be reached.
     tie_break
         Break ties among equally good nodes at random from ``seed`` (gives different but
@@ -296,6 +297,10 @@ def plan(
         model=model,
         start=start,
     )
+    if not task.semantics.simulates_pushes:
+        # A learned prediction (CBST) costs less than shipping its job to a worker and back:
+        # workers only slowed such a search down, so it runs in this process (same plan).
+        runner = SerialRunner()
     index = task.dominance_index()
     spec = WorkerSpec(problem, semantics, particles, seed, heuristic, model)
     evaluator = SuccessorEvaluator(task, runner, spec, index)

@@ -14,7 +14,7 @@ from test_parallel import _die_once
 import arrange_up
 from arrange_up import parallel
 from arrange_up.belief.states import ParticleBelief
-from arrange_up.model.problem import SERVO_CONTROLLER
+from arrange_up.model.problem import SERVO_CONTROLLER, driven_by
 from arrange_up.model.world import WorldState
 from arrange_up.parallel import get_runner
 from arrange_up.planning import successors
@@ -129,3 +129,16 @@ def test_a_belief_from_another_process_hashes_as_one_made_here():
 
 def _make_belief(context: object, particles: int) -> ParticleBelief:
     return _belief(particles)
+
+
+def test_cbst_plans_in_this_process_whatever_the_workers(monkeypatch):
+    # A learned prediction is cheaper than a worker's round trip: with workers asked for, a
+    # CBST search opens no worker session, and its plan is the serial one.
+    def refuse(self, fn, context):
+        raise AssertionError("a CBST search opened a worker session")
+
+    monkeypatch.setattr(parallel.LocalRunner, "session", refuse)
+    problem = driven_by(arrange_up.load("blocks-2"), "servo")  # the model that plans it
+    serial = plan(problem, semantics="cbst", workers=1)
+    asked = plan(problem, semantics="cbst", workers=2)
+    assert asked.status.value == "solved" and asked.actions == serial.actions
