@@ -9,11 +9,12 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import matplotlib
 import matplotlib.pyplot
 
-__all__ = ["FIGURE_SUFFIXES", "figure_format", "pyplot"]
+__all__ = ["FIGURE_SUFFIXES", "figure_format", "pyplot", "save_figure"]
 
 #: Picture formats a figure is saved in, by the suffix of its file.
 FIGURE_SUFFIXES: dict[str, str] = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
@@ -36,3 +37,13 @@ def figure_format(path: str | Path) -> str:
             f"file name ending in {', '.join(FIGURE_SUFFIXES)}"
         )
     return FIGURE_SUFFIXES[suffix]
+
+
+def save_figure(fig: Any, output: str | Path, *, dpi: int, **options: Any) -> Path:
+    """Write ``fig`` at ``output``, its folders made first, in the format its suffix names
+    (:func:`figure_format`); ``options`` go to ``savefig``. Returns the path. The caller
+    closes the figure."""
+    output = Path(output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(output, dpi=dpi, format=figure_format(output), **options)
+    return output

@@ -23,13 +23,13 @@ from matplotlib.lines import Line2D
 
 from arrange_up.execution.replanning import LoopOutcome
 from arrange_up.figures import render
-from arrange_up.figures.backend import figure_format, pyplot
+from arrange_up.figures.backend import pyplot, save_figure
 from arrange_up.figures.scene import (
     describe,
     draw_action,
     draw_scene,
     legend_handles,
-    panel_grid,
+    panel_figure,
     scene_at,
     style_axes,
 )
@@ -75,21 +75,9 @@ def draw_episode(
     steps = outcome.trace
     replanned = {r.after for r in outcome.replans}
     plt = pyplot()
-    panels = len(steps) + 1
-    rows, columns, scale = panel_grid(problem, panels, columns)
-    width, depth = problem.table.size
-    fig, axes = plt.subplots(
-        rows,
-        columns,
-        figsize=(columns * width * scale + 0.4, rows * (depth * scale + 0.3) + 1.4),
-        squeeze=False,
-    )
+    fig, axes, _ = panel_figure(problem, len(steps) + 1, columns, row_margin=0.3, margin=1.4)
     try:
-        for k in range(rows * columns):
-            ax = axes[k // columns][k % columns]
-            if k >= panels:
-                ax.axis("off")
-                continue
+        for k, ax in enumerate(axes):
             draw_scene(ax, problem, scene_at(data, k))
             label = "start"
             if k > 0:
@@ -119,12 +107,9 @@ def draw_episode(
         )
         fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=7, frameon=False)
         fig.tight_layout(rect=(0, 0.7 / fig.get_figheight(), 1, 1))
-        output = Path(output)
-        output.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(output, dpi=dpi, format=figure_format(output))
+        return save_figure(fig, output, dpi=dpi)
     finally:
         plt.close(fig)
-    return output
 
 
 def _draw_observation(ax: Any, problem: ArrangementProblem, step: Any) -> None:

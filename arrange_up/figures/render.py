@@ -36,7 +36,7 @@ from matplotlib.patches import Patch, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
 from shapely.geometry import Polygon
 
-from arrange_up.figures.backend import figure_format, pyplot
+from arrange_up.figures.backend import pyplot, save_figure
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.se2 import compose, rotate
 from arrange_up.io.domains import first_sentence
@@ -628,15 +628,11 @@ def draw_problem(
     ``title`` replaces the default title (the problem's name and first sentence).
     """
     plt = pyplot()
-    output = Path(output)
-    if output.parent != Path(""):
-        output.parent.mkdir(parents=True, exist_ok=True)
     fig = problem_figure(problem, title=title)
     try:
-        fig.savefig(output, dpi=dpi, bbox_inches="tight", format=figure_format(output))
+        return save_figure(fig, output, dpi=dpi, bbox_inches="tight")
     finally:
         plt.close(fig)
-    return output
 
 
 # ---------------------------------------------------------------------------------------------
@@ -887,12 +883,8 @@ def write_heatmap(
     """Save :func:`heatmap_figure` of ``scores`` at ``output`` (PNG, SVG or PDF, by its
     suffix); returns the path."""
     plt = pyplot()
-    output = Path(output)
-    if output.parent != Path(""):
-        output.parent.mkdir(parents=True, exist_ok=True)
     fig = heatmap_figure(problem, scores, title=title, **kwargs)
     try:
-        fig.savefig(output, dpi=dpi, bbox_inches="tight", format=figure_format(output))
+        return save_figure(fig, output, dpi=dpi, bbox_inches="tight")
     finally:
         plt.close(fig)
-    return output

@@ -33,6 +33,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from arrange_up.figures import render
+from arrange_up.figures.backend import pyplot
 from arrange_up.geometry.se2 import compose, rotate
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
@@ -299,12 +300,28 @@ def describe(action: Action, problem: ArrangementProblem) -> str:
     return f"pick {action.obj}"
 
 
-def panel_grid(problem: ArrangementProblem, panels: int, columns: int) -> tuple[int, int, float]:
-    """The grid of a storyboard of ``panels`` table panels at most ``columns`` wide:
-    ``(rows, columns, scale)``, ``scale`` the figure inches per table unit that draws the
-    table's longer side 3.6 in long."""
+def panel_figure(
+    problem: ArrangementProblem, panels: int, columns: int, *, row_margin: float, margin: float
+) -> tuple[Any, list[Axes], int]:
+    """A storyboard's figure: ``panels`` table panels in rows of at most ``columns``, the
+    table's longer side 3.6 in long, each row ``row_margin`` inches taller than its table (its
+    titles and axis labels) and the figure ``margin`` inches taller still (title and legend);
+    the spare axes of the last row are switched off. Returns the figure, the panels' axes in
+    reading order and the number of columns used."""
     columns = max(1, min(columns, panels))
-    return math.ceil(panels / columns), columns, 3.6 / max(problem.table.size)
+    rows = math.ceil(panels / columns)
+    width, depth = problem.table.size
+    scale = 3.6 / max(width, depth)
+    fig, grid = pyplot().subplots(
+        rows,
+        columns,
+        figsize=(columns * width * scale + 0.4, rows * (depth * scale + row_margin) + margin),
+        squeeze=False,
+    )
+    axes = [ax for row in grid for ax in row]
+    for ax in axes[panels:]:
+        ax.axis("off")
+    return fig, axes[:panels], columns
 
 
 def style_axes(ax: Axes, problem: ArrangementProblem, *, fontsize: float = 7) -> None:

@@ -24,14 +24,14 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.evaluation.rollouts import trace_rollout
-from arrange_up.figures.backend import figure_format, pyplot
+from arrange_up.figures.backend import pyplot, save_figure
 from arrange_up.figures.scene import (
     describe,
     draw_action,
     draw_scene,
     has_shadows,
     legend_handles,
-    panel_grid,
+    panel_figure,
     prediction_label,
     scene_at,
     style_axes,
@@ -133,24 +133,11 @@ def draw_storyboard(
         progress=progress,
     )
     plt = pyplot()
-    panels = len(actions) + 1
-    rows, columns, scale = panel_grid(problem, panels, columns)
-    width, depth = problem.table.size
-    fig, axes = plt.subplots(
-        rows,
-        columns,
-        figsize=(
-            columns * width * scale + 0.4,
-            rows * (depth * scale + LABEL_HEIGHT) + LEGEND_HEIGHT + 0.9,
-        ),
-        squeeze=False,
+    fig, axes, columns = panel_figure(
+        problem, len(actions) + 1, columns, row_margin=LABEL_HEIGHT, margin=LEGEND_HEIGHT + 0.9
     )
     try:
-        for k in range(rows * columns):
-            ax = axes[k // columns][k % columns]
-            if k >= panels:
-                ax.axis("off")
-                continue
+        for k, ax in enumerate(axes):
             _draw_panel(ax, problem, data, actions, k)
         label = prediction_label(semantics, particles, plan_semantics)
         fig.suptitle(f"{problem.name}: {len(actions)} actions; {label}", fontsize=10)
@@ -163,12 +150,9 @@ def draw_storyboard(
             frameon=False,
         )
         fig.tight_layout(rect=(0, LEGEND_HEIGHT / fig.get_figheight(), 1, 1))
-        output = Path(output)
-        output.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(output, dpi=dpi, format=figure_format(output))
+        return save_figure(fig, output, dpi=dpi)
     finally:
         plt.close(fig)
-    return output
 
 
 #: Inches below the panels for the legend, and below each row for its axis labels.
