@@ -20,6 +20,7 @@ from arrange_up.cli.shared import (
     echo_json,
     fail,
     json_option,
+    landing_option,
     library_default,
     load_problem,
     parallel_options,
@@ -30,7 +31,6 @@ from arrange_up.cli.shared import (
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.evaluation.reliability import EvaluationProgress, FailureBreakdown
-from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action, Push
 from arrange_up.parallel import BackendUnavailableError
@@ -110,14 +110,7 @@ def _failure_lines(
     help="Append every rollout to this .jsonl file as it finishes; re-running with the same "
     "file resumes the evaluation.",
 )
-@click.option(
-    "--landing",
-    type=click.Choice(LANDINGS),
-    default="fail",
-    show_default=True,
-    help="A push whose paddle is put down onto a part: fail the action, or shove (let the "
-    "physics resolve the overlap and go on).",
-)
+@landing_option()
 @json_option("Print a machine-readable summary (JSON) on stdout.")
 def evaluate(
     problem: str,

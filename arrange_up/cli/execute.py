@@ -14,12 +14,12 @@ from arrange_up.cli.shared import (
     echo_json,
     fail,
     json_option,
+    landing_option,
     load_problem,
     read_plan_file,
     seed_option,
 )
 from arrange_up.evaluation.records import RecordFileError, plan_hash
-from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.observations import SENSES
 from arrange_up.execution.replanning import ClosedLoopSettings
@@ -99,14 +99,7 @@ _DEFAULTS = ClosedLoopSettings()
     show_default=True,
     help="The simulated world's noise, as a multiple of the problem's modelled noise.",
 )
-@click.option(
-    "--landing",
-    type=click.Choice(LANDINGS),
-    default="fail",
-    show_default=True,
-    help="A push whose paddle is put down onto a part: fail the action, or shove (let the "
-    "physics resolve the overlap and go on), in the world and in the belief alike.",
-)
+@landing_option(", in the world and in the belief alike")
 @click.option(
     "--record",
     type=OutputFile(),

@@ -25,6 +25,7 @@ import click
 from rich.console import Console
 from rich.progress import Progress, ProgressColumn
 
+from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.io.domains import UnknownDomainError, load_checked
 from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_mismatch, read_plan
 from arrange_up.model.errors import ProblemFormatError
@@ -132,6 +133,19 @@ def timeout_option(help: str) -> Callable[[Any], Any]:
     """``--timeout``: positive finite seconds, default none; ``help`` says what it limits."""
     return click.option(
         "--timeout", type=FiniteFloat(0, None, min_open=True), default=None, help=help
+    )
+
+
+def landing_option(where: str = "") -> Callable[[Any], Any]:
+    """``--landing fail|shove``: the rule for a push whose paddle is put down onto a part;
+    ``where`` ends the help (e.g. where the rule applies)."""
+    return click.option(
+        "--landing",
+        type=click.Choice(LANDINGS),
+        default="fail",
+        show_default=True,
+        help="A push whose paddle is put down onto a part: fail the action, or shove (let the "
+        f"physics resolve the overlap and go on){where}.",
     )
 
 
