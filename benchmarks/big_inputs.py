@@ -78,12 +78,7 @@ uncertainty:
 def star_problem(n: int) -> str:
     """A YAML problem whose part A is an ``n``-vertex star (radii 1.0 and 0.8 in alternately;
     ``n`` even), full double precision so that the file is as big as a real export's."""
-    points = []
-    for k in range(n):
-        radius = 1.0 if k % 2 == 0 else 0.8
-        angle = 2.0 * math.pi * k / n
-        points.append(f"[{radius * math.cos(angle):.9f}, {radius * math.sin(angle):.9f}]")
-    return _HEADER.format(n=n, points=", ".join(points))
+    return _HEADER.format(n=n, points=_star_points(n, 1.0, 0.8))
 
 
 def many_objects(n: int, uncertain: bool = True) -> str:
