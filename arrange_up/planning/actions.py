@@ -435,9 +435,18 @@ class ActionGenerator:
         )
         pushes = []
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
-            # Clear of the obstacles the paddle would sweep into where it can be; where it
-            # cannot (it would stop on one as the part reaches its end), where it was.
+            # Clear of the obstacles the paddle would sweep into where its approach shadow can
+            # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
+            # the shadow and APPROACH_GAP add across: only a noisy approach grazes them); else
+            # where it was (it stops on one as the part reaches its end).
             centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table, sweep)
+            if sweep and not centres:
+                other = 1 - axis
+                margin = 0.5 * (m_box[other + 2] - m_box[other] - manip.length) + APPROACH_GAP
+                shrunk = tuple(_shrink(box, other, margin) for box in sweep)
+                centres = self._across(
+                    manip, name, interval, axis, sign, along, m_box, on_table, shrunk
+                )
             if sweep and not centres:
                 centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table)
             for across in centres:
@@ -843,6 +852,16 @@ def _describe(spec: ObjectSpec) -> _Manipulator:
     px, py = spec.push_direction
     length, thickness = (xmax - xmin, ymax - ymin) if py else (ymax - ymin, xmax - xmin)
     return _Manipulator(spec, length, thickness, math.atan2(py, px))
+
+
+def _shrink(box, axis: int, margin: float):
+    """``box`` narrowed by ``margin`` on both sides along ``axis`` (to its centre at most)."""
+    low, high = box[axis] + margin, box[axis + 2] - margin
+    if low > high:
+        low = high = 0.5 * (box[axis] + box[axis + 2])
+    bounds = list(box)
+    bounds[axis], bounds[axis + 2] = low, high
+    return tuple(bounds)
 
 
 def _clean(pose: Pose) -> Pose:
