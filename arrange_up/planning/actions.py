@@ -46,7 +46,29 @@ Distances:
 * **a ladder** of travels (``LADDER``) for a part without a goal position of its own (the
   reference of a relative goal), keeping its nominal footprint on the table, offered only
   while some goal part cannot be placed at all (the reference may have to make room);
-* each of ``planning.push_distances`` (how far the part should travel).
+* each of ``planning.push_distances`` (how far the part should travel);
+* **a squeeze**, where the narrowing push is offered: to the face of the nearest obstacle, or
+  of a fixture's shadow on the table, ahead of the part that covers its centre across the push
+  with a quarter of the part to spare (the paddle's front set at that face, as for a wall:
+  the controller stalls with the part pressed against it);
+* **a detour** round obstacles (:mod:`arrange_up.planning.obstacles`): where the straight push
+  to the part's goal coordinate along one axis is blocked (an obstacle's box lies across the
+  part's shadow, widened by ``obstacles.GAP``, before the goal), a push along the other axis,
+  to the nearer side where the shadow (with the spread a push leaves across it) clears the
+  blocking boxes by ``GAP`` and stays on the table, even away from the goal along that axis;
+  not where the goal-directed push across already clears them;
+* **cut short** before an obstacle: where one of the distances above (but a squeeze) would
+  bring the part's shadow within ``GAP`` of an obstacle ahead in its swath, the distance that
+  stops it ``GAP`` short (allowing for the part's depth at its angle spread and the approach
+  noise). The pushes that would drive a state of the part into the obstacle stay offered only
+  where no detour push of the part fits (a part lying on a wall cannot be pushed off it, so
+  running it into a post and round its corner is its only way on).
+
+A paddle whose travel would sweep it into an obstacle outside the part's swath is shifted along
+its long side, as beside walls and shadows, to pass it clear with its approach shadow, or else
+with its nominal outline, or else (no such position covers the part's centre) left where it
+was. None of the obstacle rules changes anything on a table without obstacles (every shipped
+problem), and fixtures on the table give only squeezes.
 
 Under the compliant controller (``problem.controller.kind == "compliant"``) a resisted push
 stops short of its set point by about the resisting friction / Kp, so the distances to a goal
@@ -57,8 +79,8 @@ of the pushed part and of the parts in a row ahead of it whose shadows it would 
 force clip presses the train against it). Under the servo the stall is zero and the distances
 are as before.
 
-A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
-such a push cannot help it, and it multiplies the search's plateaus.
+A part is never pushed away from its own goal (beyond the goal tolerance along the direction),
+but for a detour: such a push cannot help it, and it multiplies the search's plateaus.
 
 **Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
