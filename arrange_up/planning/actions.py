@@ -432,8 +432,8 @@ class ActionGenerator:
         detour: float | None = None,
         jams: list[Push] | None = None,
     ) -> list[Push]:
-        """The pushes of ``name`` along ``direction``; those that drive the nominal part into
-        an obstacle are also appended to ``jams``."""
+        """The pushes of ``name`` along ``direction``; those that would drive a state of the
+        part into an obstacle (:meth:`_cut_short`) are also appended to ``jams``."""
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
         sign = int(ux + uy)  # +1 or -1
