@@ -46,7 +46,29 @@ Distances:
 * **a ladder** of travels (``LADDER``) for a part without a goal position of its own (the
   reference of a relative goal), keeping its nominal footprint on the table, offered only
   while some goal part cannot be placed at all (the reference may have to make room);
-* each of ``planning.push_distances`` (how far the part should travel).
+* each of ``planning.push_distances`` (how far the part should travel);
+* **a squeeze**, where the narrowing push is offered: to the face of the nearest obstacle, or
+  of a fixture's shadow on the table, ahead of the part that covers its centre across the push
+  with a quarter of the part to spare (the paddle's front set at that face, as for a wall:
+  the controller stalls with the part pressed against it);
+* **a detour** round obstacles (:mod:`arrange_up.planning.obstacles`): where the straight push
+  to the part's goal coordinate along one axis is blocked (an obstacle's box lies across the
+  part's shadow, widened by ``obstacles.GAP``, before the goal), a push along the other axis,
+  to the nearer side where the shadow (with the spread a push leaves across it) clears the
+  blocking boxes by ``GAP`` and stays on the table, even away from the goal along that axis;
+  not where the goal-directed push across already clears them;
+* **cut short** before an obstacle: where one of the distances above (but a squeeze) would
+  bring the part's shadow within ``GAP`` of an obstacle ahead in its swath, the distance that
+  stops it ``GAP`` short (allowing for the part's depth at its angle spread and the approach
+  noise). The pushes that would drive a state of the part into the obstacle stay offered only
+  where no detour push of the part fits (a part lying on a wall cannot be pushed off it, so
+  running it into a post and round its corner is its only way on).
+
+A paddle whose travel would sweep it into an obstacle outside the part's swath is shifted along
+its long side, as beside walls and shadows, to pass it clear with its approach shadow, or else
+with its nominal outline, or else (no such position covers the part's centre) left where it
+was. None of the obstacle rules changes anything on a table without obstacles (every shipped
+problem), and fixtures on the table give only squeezes.
 
 Under the compliant controller (``problem.controller.kind == "compliant"``) a resisted push
 stops short of its set point by about the resisting friction / Kp, so the distances to a goal
@@ -57,8 +79,8 @@ of the pushed part and of the parts in a row ahead of it whose shadows it would 
 force clip presses the train against it). Under the servo the stall is zero and the distances
 are as before.
 
-A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
-such a push cannot help it, and it multiplies the search's plateaus.
+A part is never pushed away from its own goal (beyond the goal tolerance along the direction),
+but for a detour: such a push cannot help it, and it multiplies the search's plateaus.
 
 **Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
@@ -94,6 +116,7 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
 from arrange_up.planning.fences import Fences
+from arrange_up.planning.obstacles import GAP, Obstacles, far_face
 
 #: The wall each push direction heads for.
 _WALL_AHEAD = {"+x": "right", "-x": "left", "+y": "top", "-y": "bottom"}
@@ -104,6 +127,8 @@ DIRECTIONS: dict[str, tuple[float, float]] = {
     "+y": (0.0, 1.0),
     "-y": (0.0, -1.0),
 }
+#: ``(axis, sign)`` -> direction name.
+_DIRECTION_OF = {(0 if ux else 1, int(ux + uy)): name for name, (ux, uy) in DIRECTIONS.items()}
 #: Gap kept between the manipulator's approach shadow and the part's shadow (inches).
 APPROACH_GAP = 0.02
 #: Minimum useful push (inches): shorter candidates are dropped.
@@ -163,6 +188,7 @@ class ActionGenerator:
             if train is not None and _WALL_AHEAD[direction] in walls
         }
         self.fences = Fences(problem, checker, held)
+        self.obstacles = Obstacles(checker)
         self.offsets = {
             spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
             for spec in problem.parts
@@ -324,23 +350,97 @@ class ActionGenerator:
                 interval = belief.get(spec.name)
                 if interval is None:
                     continue
+                detours = self._detours(spec.name, interval, belief) if self.obstacles else {}
+                jams: list[Push] = []
+                mine: list[Push] = []
+                detoured = False
                 for direction in self.directions:
-                    actions.extend(
-                        self._pushes_of(
-                            manip, spec.name, interval, direction, belief, on_table, ladder, routes
-                        )
+                    pushes = self._pushes_of(
+                        manip,
+                        spec.name,
+                        interval,
+                        direction,
+                        belief,
+                        on_table,
+                        ladder,
+                        routes,
+                        detours.get(direction),
+                        jams,
                     )
+                    detoured = detoured or (direction in detours and bool(pushes))
+                    mine.extend(pushes)
+                # A push that drives the part into an obstacle only where it cannot go round.
+                if detoured and jams:
+                    mine = [push for push in mine if push not in jams]
+                actions.extend(mine)
         return actions
 
+    def _detours(self, name: str, interval, belief: IntervalBelief) -> dict[str, float]:
+        """The sideways travels that take ``name`` round the obstacles blocking its straight
+        push to its goal coordinate, by direction (module docstring: at most one per blocked
+        axis, to the nearer side where its shadow clears them by ``GAP`` and stays on the
+        table)."""
+        target = self.place_target(name, belief)
+        if target is None:
+            return {}
+        shadow = self.checker.shadow_box(name, interval.center, interval.half)
+        detours: dict[str, float] = {}
+        for axis in (0, 1):
+            travel = target[axis] - interval.center[axis]
+            if abs(travel) <= MIN_PUSH:
+                continue
+            sign, other = (1 if travel > 0 else -1), 1 - axis
+            band = (shadow[other] - GAP, shadow[other + 2] + GAP)
+            blocks = self.obstacles.blocking(
+                far_face(shadow, axis, sign), band, axis, sign, abs(travel)
+            )
+            if not blocks:
+                continue
+            # The shadow after a sideways push: its spread across the push is the push's own.
+            half = list(interval.half)
+            half[other] = self.push_unc[other]
+            end = self.checker.shadow_box(name, interval.center, tuple(half))
+            size = self.problem.table.size[other]
+            sides = (
+                (max(b[other + 2] for b in blocks) + GAP - end[other], 1),
+                (end[other + 2] - (min(b[other] for b in blocks) - GAP), -1),
+            )
+            feasible = [
+                (t, side)
+                for t, side in sides
+                if t > MIN_PUSH
+                and end[other] + side * t >= 0.0
+                and end[other + 2] + side * t <= size
+            ]
+            # None where the goal-directed push across already takes the shadow clear.
+            across = target[other] - interval.center[other]
+            if feasible and not any(side * across >= t for t, side in sides):
+                t, side = min(feasible)
+                detours[_DIRECTION_OF[(other, side)]] = t
+        return detours
+
     def _pushes_of(
-        self, manip, name, interval, direction, belief, on_table, ladder=False, routes=None
+        self,
+        manip,
+        name,
+        interval,
+        direction,
+        belief,
+        on_table,
+        ladder=False,
+        routes=None,
+        detour: float | None = None,
+        jams: list[Push] | None = None,
     ) -> list[Push]:
+        """The pushes of ``name`` along ``direction``; those that would drive a state of the
+        part into an obstacle (:meth:`_cut_short`) are also appended to ``jams``."""
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
         sign = int(ux + uy)  # +1 or -1
         target = self.place_target(name, belief)
         tolerance = self.problem.goal.tolerance[axis]
-        if target is not None and sign * (target[axis] - interval.center[axis]) < -tolerance:
+        away = target is not None and sign * (target[axis] - interval.center[axis]) < -tolerance
+        if away and detour is None:
             return []  # it would push the part away from where it must end
         theta = wrap_angle(math.atan2(uy, ux) - manip.push_angle, 0.0, 2.0 * math.pi)
         part_box = self.checker.shadow_box(name, interval.center, interval.half)
@@ -352,29 +452,65 @@ class ActionGenerator:
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
-        distances = self._distances(
-            name, interval, belief, axis, sign, front_nominal, ladder, routes or {}
+        distances, jammed = self._distances(
+            name, interval, belief, axis, sign, front_nominal, ladder, routes or {}, detour, away
         )
         pushes = []
-        for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
-            pose = (along, across, theta) if axis == 0 else (across, along, theta)
-            if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
-                for d, travel in distances:
-                    push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
-                    if self.stall_per_area and travel is not None:
-                        distance = self._solve_distance(push, name, axis, sign, travel, belief)
-                        push = Push(push.manipulator, push.pose, distance)
-                    pushes.append(push)
+        for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
+            # Clear of the obstacles the paddle would sweep into where its approach shadow can
+            # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
+            # the shadow and APPROACH_GAP add across: only a noisy approach grazes them); else
+            # where it was (it stops on one as the part reaches its end).
+            centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table, sweep)
+            if sweep and not centres:
+                other = 1 - axis
+                margin = 0.5 * (m_box[other + 2] - m_box[other] - manip.length) + APPROACH_GAP
+                shrunk = tuple(_shrink(box, other, margin) for box in sweep)
+                centres = self._across(
+                    manip, name, interval, axis, sign, along, m_box, on_table, shrunk
+                )
+            if sweep and not centres:
+                centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table)
+            for across in centres:
+                pose = (along, across, theta) if axis == 0 else (across, along, theta)
+                if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
+                    for d, travel in group:
+                        push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
+                        if self.stall_per_area and travel is not None:
+                            distance = self._solve_distance(push, name, axis, sign, travel, belief)
+                            push = Push(push.manipulator, push.pose, distance)
+                        pushes.append(push)
+                        if d in jammed and jams is not None:
+                            jams.append(push)
         return pushes
 
-    def _across(self, manip, name, interval, axis, sign, along, m_box, on_table) -> list[float]:
+    def _sweeps(self, distances, along, m_box, part_box, axis, sign):
+        """``distances`` grouped by the obstacles the paddle's approach shadow would sweep into
+        (outside the part's swath) on the way, in order: ``(obstacle boxes, distances)``. With
+        no obstacle on the way (every distance of a problem without obstacles) one group."""
+        if not self.obstacles:
+            return [((), distances)]
+        start = (along + m_box[axis], along + m_box[axis + 2])
+        rear, front = (start[0], start[1]) if sign > 0 else (-start[1], -start[0])
+        other = 1 - axis
+        swath = (part_box[other], part_box[other + 2])
+        groups: dict[tuple, list] = {}
+        for d, travel in distances:
+            hits = tuple(self.obstacles.swept(rear, front, d, swath, axis, sign))
+            groups.setdefault(hits, []).append((d, travel))
+        return list(groups.items())
+
+    def _across(
+        self, manip, name, interval, axis, sign, along, m_box, on_table, sweep=()
+    ) -> list[float]:
         """Where to centre the manipulator across the push (at most two centres).
 
-        The first is as near the part's centre as the walls and the shadows beside the approach
-        allow, while the manipulator's long side still covers the part's centre (with 0.1 in to
-        spare). With ``unclipped_pushes``, when it clips the side of a shadow *ahead* of the
-        approach (the manipulator's span overlaps that shadow's span without covering it whole,
-        so the contact may or may not happen), the second is the nearest centre at which every
+        The first is as near the part's centre as the walls, the shadows beside the approach
+        and the obstacle boxes in ``sweep`` (those its travel would meet) allow, while the
+        manipulator's long side still covers the part's centre (with 0.1 in to spare). With
+        ``unclipped_pushes``, when it clips the side of a shadow *ahead* of the approach (the
+        manipulator's span overlaps that shadow's span without covering it whole, so the
+        contact may or may not happen), the second is the nearest centre at which every
         shadow ahead is either missed or covered whole. Empty if no centre fits.
         """
         other = 1 - axis
@@ -400,6 +536,12 @@ class ActionGenerator:
             )
             for box in boxes + list(self.checker.obstacle_boxes.values())
             if box[axis + 2] > a_lo - APPROACH_GAP and box[axis] < a_hi + APPROACH_GAP
+        ] + [
+            (
+                box[other] - m_box[other + 2] - APPROACH_GAP,
+                box[other + 2] - m_box[other] + APPROACH_GAP,
+            )
+            for box in sweep
         ]
         # Shadows ahead (only with unclipped_pushes): the centres at which the approach shadow
         # touches one (the interval it is forbidden from when level) and those at which the
@@ -444,17 +586,35 @@ class ActionGenerator:
         return low, high
 
     def _distances(
-        self, name, interval, belief, axis, sign, front, ladder=False, routes=None
-    ) -> list[tuple[float, float | None]]:
+        self,
+        name,
+        interval,
+        belief,
+        axis,
+        sign,
+        front,
+        ladder=False,
+        routes=None,
+        detour: float | None = None,
+        away: bool = False,
+    ) -> tuple[list[tuple[float, float | None]], set[float]]:
         """Candidate travel distances of the manipulator (see the module docstring), each with
-        the travel of the part it is meant for (``None`` for a push to the wall)."""
+        the travel of the part it is meant for (``None`` for a push to the wall, a squeeze or a
+        push cut short), and the distances among them that jam the part on an obstacle.
+        ``detour``: a sideways travel round an obstacle (:meth:`_detours`); ``away``: the push
+        moves the part away from its goal, so only the detour is offered."""
         size = self.problem.table.size[axis]
         wall = {(0, 1): "right", (0, -1): "left", (1, 1): "top", (1, -1): "bottom"}[(axis, sign)]
         nominal = self.checker.shadow_box(name, interval.center, (0.0, 0.0, 0.0))
         rear = sign * (nominal[axis] if sign > 0 else nominal[axis + 2])
         gap = rear - front  # nominal free travel before contact
+        stall = self._stall(name, belief, axis, sign) if self.stall_per_area else 0.0
+        if away:  # only the detour (_pushes_of does not call this for an away push without one)
+            return self._cut_short(
+                name, interval, axis, sign, front, gap, [(gap + detour + stall, detour)]
+            )
         candidates = []
-        direction = {(0, 1): "+x", (0, -1): "-x", (1, 1): "+y", (1, -1): "-y"}[(axis, sign)]
+        direction = _DIRECTION_OF[(axis, sign)]
         train = self.wall_trains.get((name, direction), ())
         if (
             wall in self.problem.table.walls
@@ -486,11 +646,11 @@ class ActionGenerator:
             fenced = self.fences.needed(name, axis) and (
                 face is not None or (name, axis, sign) in (routes or {})
             )
-        stall = self._stall(name, belief, axis, sign) if self.stall_per_area else 0.0
         travels: dict[float, float | None] = dict.fromkeys(candidates)
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
         # a narrowing push, to the contact of the rearmost state.
         least: dict[float, float] = {}
+        squeezes: set[float] = set()
         if target is not None:
             travel = sign * (target[axis] - interval.center[axis])
             half = interval.half[axis]
@@ -506,6 +666,12 @@ class ActionGenerator:
                 d = gap + travel + stall
                 travels.setdefault(d, None)
                 least[d] = gap - half
+                # A squeeze: pressed against an obstacle or a fixture ahead, as against a wall.
+                face = self._squeeze_face(name, interval, belief, axis, sign)
+                if face is not None:
+                    squeezes.add(face - front)
+                    travels.setdefault(face - front, None)
+                    least[face - front] = gap - half
         elif ladder and not candidates and not self.push_distances:
             # No goal position (the reference part of a relative goal): a short ladder of
             # travels, those that keep the part's nominal footprint on the table.
@@ -514,6 +680,8 @@ class ActionGenerator:
                 shifted = (low + sign * d, high + sign * d)
                 if shifted[0] >= 0.0 and shifted[1] <= size:
                     travels.setdefault(gap + d + stall, d)
+        if detour is not None:
+            travels.setdefault(gap + detour + stall, detour)
         for d in self.push_distances:
             travels.setdefault(gap + d + stall, d)
         result: list[tuple[float, float | None]] = []
@@ -522,7 +690,68 @@ class ActionGenerator:
                 abs(d - r) > DISTANCE_RESOLUTION for r, _ in result
             ):
                 result.append((d, travels[d]))
-        return result
+        if self.obstacles:
+            return self._cut_short(name, interval, axis, sign, front, gap, result, squeezes)
+        return result, set()
+
+    def _cut_short(self, name, interval, axis, sign, front, gap, result, squeezes=frozenset()):
+        """``result`` (sorted ``(distance, travel)`` pairs) with the pushes that jam the part on
+        an obstacle ahead in its swath cut short (module docstring): when a distance (but a
+        squeeze's) would bring the part's shadow within ``GAP`` of the obstacle, the distance
+        that stops it ``GAP`` short (the paddle's front ends there less the part's depth at its
+        angle spread and the approach noise along the push) is added, if it moves the part more
+        than ``MIN_PUSH``. Also returns the distances (but a squeeze's) that would drive some
+        state of the part into the obstacle."""
+        other = 1 - axis
+        shadow = self.checker.shadow_box(name, interval.center, interval.half)
+        stop = self.obstacles.face_ahead(
+            far_face(shadow, axis, sign), (shadow[other], shadow[other + 2]), axis, sign
+        )
+        if stop is None:
+            return result, set()
+        # A state of the part meets the obstacle when the paddle's front ends less than the
+        # part's depth before the face.
+        nominal = self.checker.shadow_box(name, interval.center, (0.0, 0.0, 0.0))
+        depth = nominal[axis + 2] - nominal[axis]
+        jammed = {
+            d
+            for d, _ in result
+            if d not in squeezes and front + d + depth > stop + DISTANCE_RESOLUTION
+        }
+        turned = self.checker.shadow_box(name, interval.center, (0.0, 0.0, interval.half[2]))
+        short = stop - GAP - (turned[axis + 2] - turned[axis]) - self.push_unc[axis] - front
+        if (
+            short <= gap + MIN_PUSH
+            or not any(d > short for d, _ in result if d not in squeezes)
+            or any(abs(d - short) <= DISTANCE_RESOLUTION for d, _ in result)
+        ):
+            return result, jammed
+        return sorted([*result, (short, None)]), jammed
+
+    def _squeeze_face(self, name, interval, belief, axis, sign) -> float | None:
+        """The signed coordinate of the face a squeeze presses ``name`` against along the push:
+        the nearest near face ahead of an obstacle or of a fixture's shadow on the table that
+        covers the part's centre across the push with a quarter of the part to spare; None if
+        there is none (or the problem has neither)."""
+        fixtures = tuple(
+            self.checker.shadow_box(spec.name, iv.center, iv.half)
+            for spec in self.problem.fixtures
+            if (iv := belief.get(spec.name)) is not None
+        )
+        if not self.obstacles and not fixtures:
+            return None
+        other = 1 - axis
+        nominal = self.checker.shadow_box(name, interval.center, (0.0, 0.0, 0.0))
+        spare = 0.25 * (nominal[other + 2] - nominal[other])
+        centre = interval.center[other]
+        return self.obstacles.face_ahead(
+            far_face(nominal, axis, sign),
+            (centre - spare, centre + spare),
+            axis,
+            sign,
+            fixtures,
+            cover=True,
+        )
 
     def _settled(self, parts: tuple[str, ...], belief: IntervalBelief, axis: int) -> bool:
         """Whether every one of ``parts`` lies within its goal interval along ``axis`` in every
@@ -645,6 +874,16 @@ def _describe(spec: ObjectSpec) -> _Manipulator:
     px, py = spec.push_direction
     length, thickness = (xmax - xmin, ymax - ymin) if py else (ymax - ymin, xmax - xmin)
     return _Manipulator(spec, length, thickness, math.atan2(py, px))
+
+
+def _shrink(box, axis: int, margin: float):
+    """``box`` narrowed by ``margin`` on both sides along ``axis`` (to its centre at most)."""
+    low, high = box[axis] + margin, box[axis + 2] - margin
+    if low > high:
+        low = high = 0.5 * (box[axis] + box[axis + 2])
+    bounds = list(box)
+    bounds[axis], bounds[axis + 2] = low, high
+    return tuple(bounds)
 
 
 def _clean(pose: Pose) -> Pose:

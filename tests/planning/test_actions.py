@@ -13,6 +13,7 @@ from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.world import Pick, Place, Push
 from arrange_up.planning.actions import MIN_PUSH, ActionGenerator
+from arrange_up.planning.obstacles import GAP
 
 NONE = (0.0, 0.0, 0.0)
 SMALL = (0.1, 0.1, 0.05)  # a belief interval's half-widths after a push or two
@@ -197,7 +198,8 @@ def test_a_part_is_never_pushed_away_from_its_goal_beyond_the_tolerance():
 
 def test_no_push_to_a_missing_wall():
     gen = generator(tiny("obstacle"))  # walls left and bottom only; goal A at (5, 0.5)
-    pushes = gen.pushes(belief(A=((2.0, 2.5, 0.0), SMALL)))
+    # (A's shadow clear of the post's x, so that no push is cut short above it.)
+    pushes = gen.pushes(belief(A=((1.8, 2.5, 0.0), SMALL)))
     # +x: to the goal's x only, since there is no right wall; -y: to the goal's y and to the
     # bottom wall, which holds A in the goal.
     assert len(distances(pushes, "+x")) == 1
@@ -395,3 +397,119 @@ def test_the_reference_of_a_relative_goal_gets_a_ladder_only_when_a_part_cannot_
     # A in the middle: B can be placed, no ladder.
     middle = belief(A=((3.0, 3.0, 0.0), (0.05, 0.05, 0.03)))
     assert gen.places(middle) and gen.pushes(middle) == []
+
+
+# -- obstacles: pushes cut short, detours, squeezes, the paddle's sweep (planning.obstacles) --
+def test_a_push_that_would_jam_on_an_obstacle_is_also_offered_cut_short():
+    # The post covers [2.5, 3.5] x [0, 1]; A's shadow (x 1.38 to 2.62) overlaps its top, so
+    # pushed down to its goal's y or to the bottom wall it lands on the post.
+    gen = generator(servo(tiny("obstacle")))
+    shape = belief(A=((2.0, 2.5, 0.0), SMALL))
+    pushes = [p for p in gen.pushes(shape) if direction_of(p) == "-y"]
+    (pose,) = {p.pose for p in pushes}
+    front = pose[1] - PADDLE_HALF_THICKNESS
+    short, *full = distances(pushes, "-y")
+    assert len(full) == 2  # to the goal's y and to the wall, as before
+    turned = gen.checker.shadow_box("A", (2.0, 2.5, 0.0), (0.0, 0.0, SMALL[2]))
+    depth = turned[3] - turned[1]
+    # Cut short: the shadow's lowest point ends GAP above the post, with the approach noise.
+    lowest = front - short - depth - gen.push_unc[1]
+    assert lowest == pytest.approx(1.0 + GAP, abs=1e-4)
+    # Clear of the post's x: nothing to cut short.
+    clear = belief(A=((1.8, 2.5, 0.0), SMALL))
+    assert len(distances(gen.pushes(clear), "-y")) == 2
+
+
+POST_ON_THE_WAY = """
+name: post-on-the-way
+table: {size: [10, 5], walls: [left, right, bottom, top]}
+objects:
+  A: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+  post: {kind: obstacle, shape: {box: [0.6, 0.6]}, pose: [6, 0.3, 0]}
+initial:
+  A: {pose: [3, 1.2, 0], uncertainty: [0.15, 0.15, 5]}
+goal:
+  tolerance: [0.2, 0.2, 15]
+  poses: {A: [9.5, 0.5, 0]}
+uncertainty: {place: [0.2, 0.2, 15], push: [0.05, 0.05, 3]}
+"""
+
+
+def test_a_part_whose_straight_push_is_blocked_is_offered_a_detour_instead():
+    # The post covers [5.7, 6.3] x [0, 0.6]; A's shadow reaches down to y 0.51, so pushed
+    # right towards its goal x it catches the post's corner.
+    gen = generator(servo(load_problem_text(POST_ON_THE_WAY, "post.yaml")))
+    start = ((3.0, 1.2, 0.0), (0.15, 0.15, math.radians(5)))
+    pushes = gen.pushes(belief(A=start))
+    # Up, away from the goal's y: just far enough for the shadow, with the spread a push
+    # leaves across it, to clear the post's top by GAP.
+    ups = [p for p in pushes if direction_of(p) == "+y"]
+    assert len(ups) == 1
+    (up,) = ups
+    end = gen.checker.shadow_box("A", start[0], (0.15, gen.push_unc[1], start[1][2]))
+    rear = start[0][1] - 0.5  # the nominal part's, where the paddle meets it
+    gap = rear - (up.pose[1] + PADDLE_HALF_THICKNESS)
+    assert end[1] + (up.distance - gap) == pytest.approx(0.6 + GAP, abs=1e-4)
+    # Right: cut short before the post; the pushes that would run into it are not offered,
+    # since the part can go round.
+    rights = [p for p in pushes if direction_of(p) == "+x"]
+    assert rights
+    depth = 1.0
+    for push in rights:
+        assert push.pose[0] + PADDLE_HALF_THICKNESS + push.distance + depth <= 5.7
+    # Above the post's top already: no detour, and the push to the goal's x is offered.
+    above = gen.pushes(belief(A=((3.0, 2.5, 0.0), SMALL)))
+    assert "+y" not in {direction_of(p) for p in above}
+    assert len(distances(above, "+x")) == 2  # to the goal's x and to the wall
+
+
+def test_a_part_that_cannot_go_round_keeps_the_push_into_the_obstacle():
+    # A lies on the bottom wall: no paddle fits under it, so the detour up is not possible
+    # and the push along the wall (the part catching the post) is kept beside the cut one.
+    gen = generator(servo(load_problem_text(POST_ON_THE_WAY, "post.yaml")))
+    pushes = gen.pushes(belief(A=((3.0, 0.6, 0.0), (0.1, 0.1, 0.05))))
+    assert "+y" not in {direction_of(p) for p in pushes}
+    rights = distances(pushes, "+x")
+    assert len(rights) == 3  # cut short, to the goal's x, to the wall
+
+
+SQUEEZE = """
+name: squeeze
+table: {size: [8, 5], walls: [bottom]}
+objects:
+  A: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+  post: {kind: obstacle, shape: {box: [0.5, 1.5]}, pose: [6.25, 0.75, 0]}
+goal:
+  tolerance: [0.1, 0.15, 15]
+  poses: {A: [5.5, 0.5, 0]}
+uncertainty: {place: [0.03, 0.03, 2], push: [0.1, 0.1, 3]}
+"""
+
+
+def test_a_belief_too_wide_at_its_goal_is_squeezed_against_the_obstacle_ahead():
+    gen = generator(servo(load_problem_text(SQUEEZE, "squeeze.yaml")))
+    wide = belief(A=((5.45, 0.55, 0.0), (0.2, 0.05, 0.03)))  # centred (within MIN_PUSH)
+    pushes = gen.pushes(wide)
+    (pose,) = {p.pose for p in pushes if direction_of(p) == "+x"}
+    front = pose[0] + PADDLE_HALF_THICKNESS
+    narrowing, squeeze = distances(pushes, "+x")
+    assert front + narrowing == pytest.approx(5.0, abs=1e-4)  # A's rear at the goal's
+    assert front + squeeze == pytest.approx(6.0, abs=1e-4)  # the paddle to the post's face
+    # Within its tolerance along x: nothing to squeeze.
+    narrow = belief(A=((5.5, 0.55, 0.0), (0.05, 0.05, 0.03)))
+    assert "+x" not in {direction_of(p) for p in gen.pushes(narrow)}
+
+
+def test_the_paddle_is_shifted_clear_of_an_obstacle_it_would_sweep_into():
+    # Pushed down to the wall from above the post's top, A's shadow (x 4.68 to 5.92) passes
+    # the post (x 6 to 6.5, top 1.5), but the paddle centred on A (x 4.05 to 6.55) would come
+    # down on it: it moves left along its long side, still covering A's centre.
+    gen = generator(servo(load_problem_text(SQUEEZE, "squeeze.yaml")))
+    pushes = [p for p in gen.pushes(belief(A=((5.3, 2.5, 0.0), SMALL))) if direction_of(p) == "-y"]
+    assert len(distances(pushes, "-y")) == 2  # to the goal's y and to the wall
+    for push in pushes:
+        box = gen.checker.shadow_box("paddle", push.pose, gen.push_unc)
+        assert box[2] < 6.0  # clear of the post
+        assert abs(push.pose[0] - 5.3) <= 0.5 * 2.5 - 0.1 + 1e-9

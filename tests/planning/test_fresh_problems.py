@@ -1,6 +1,7 @@
 """The problems of tests/problems/fresh, written from the format alone for the kinds the action
 generator once could not plan (benchmarks/fresh_problems.py measures them at full size): they
-load, and the two that need the generator's narrowing pushes and reference ladder plan."""
+load, and those that need the generator's narrowing pushes, reference ladder and detours round
+a post plan."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import pytest
 
 import arrange_up
 from arrange_up.belief.goals import GoalTest
+from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.yaml_problem import load_problem
 from arrange_up.model.world import Push
 
@@ -36,3 +38,34 @@ def test_a_relative_pair_plans_once_its_reference_has_moved_from_the_edge():
     result = arrange_up.plan(problem, particles=10, workers=1)
     assert result.solved, result.reason
     assert isinstance(result.actions[0], Push)  # A makes room before B is placed
+
+
+def _centres(result, name: str) -> list[tuple[float, float]]:
+    """``name``'s belief centre (x, y) after each action of a plan."""
+    return [tuple(float(v) for v in b.intervals.get(name).center[:2]) for b in result.beliefs[1:]]
+
+
+def test_a_post_on_the_straight_line_to_the_goal_is_gone_round():
+    # The post stands at the goal's height between the block and its goal: the plan takes the
+    # block off that line (beyond the goal's tolerance across) and back.
+    problem = load_problem(FRESH / "detour-open-post.yaml")
+    result = arrange_up.plan(problem, particles=10, workers=1)
+    assert result.solved, result.reason
+    goal_y, tolerance = problem.goal.target("A")[1], problem.goal.tolerance[1]
+    assert any(abs(y - goal_y) > tolerance + 0.5 for _, y in _centres(result, "A"))
+    final = result.beliefs[-1]
+    assert GoalTest(problem).satisfied_array(final.poses, final.names())
+
+
+def test_a_block_whose_shadow_would_catch_a_posts_corner_goes_up_first():
+    # post-detour: pushed straight right, some of the block's states catch the post's corner
+    # and turn round it; the plan pushes it up clear of the post before taking it right.
+    problem = load_problem(FRESH / "post-detour.yaml")
+    result = arrange_up.plan(problem, particles=10, workers=1)
+    assert result.solved, result.reason
+    first = result.actions[0]
+    assert isinstance(first, Push) and first.pose[2] == 0.0  # the paddle pushing up (+y)
+    # Its shadow (every state, at any angle of its spread) now passes above the post's top.
+    after = result.beliefs[1].intervals.get("A")
+    shadow = CollisionChecker(problem).shadow_box("A", after.center, after.half)
+    assert shadow[1] > 0.6
