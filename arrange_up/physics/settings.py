@@ -64,6 +64,16 @@ class PhysicsSettings:
     the engine stops solving them and their joints until something touches them; 0 turns
     sleeping off. ``None``: the controller's (the servo 0, the compliant controller 0.05;
     :data:`CONTROLLER_VALUES`)."""
+    stuck_time: float | None = None
+    """Simulated time (s) after the set point's end at which a push that has not come to rest
+    gets ``stuck_iterations`` solver iterations for the rest of it; 0 turns this off.
+    ``None``: the controller's (the servo 0, the compliant controller 1.0). A compliant paddle
+    that has turned and presses a tilted part into a wall or post wedges it, and at 5 (or 10)
+    iterations the solver makes that wedge chatter (the paddle oscillating by about 0.03 in)
+    until the cap; with more iterations it settles (``docs/design/physics.md``)."""
+    stuck_iterations: int | None = None
+    """Solver iterations per step once ``stuck_time`` has passed (``None``: the controller's,
+    20 for both)."""
     max_time: float = 20.0
     """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
     settle_steps: int = 2
@@ -108,11 +118,17 @@ class PhysicsSettings:
                 raise ValueError(
                     f"PhysicsSettings.{name} must be positive and finite, got {value!r}"
                 )
-        for name in ("rest_linear_tol", "rest_angular_tol", "overlap_tolerance", "sleep_time"):
+        for name in (
+            "rest_linear_tol",
+            "rest_angular_tol",
+            "overlap_tolerance",
+            "sleep_time",
+            "stuck_time",
+        ):
             value = getattr(self, name)
             if value is not None and not value >= 0:
                 raise ValueError(f"PhysicsSettings.{name} must be non-negative")
-        for name in ("iterations", "rest_checks"):
+        for name in ("iterations", "rest_checks", "stuck_iterations"):
             value = getattr(self, name)
             if value is not None and value < 1:
                 raise ValueError(f"PhysicsSettings.{name} must be at least 1")
@@ -157,10 +173,13 @@ SERVO_VALUES: dict[str, float | int] = {
     "rest_angular_tol": 1e-3,
     "rest_checks": 2,
     "sleep_time": 0.0,
+    "stuck_time": 0.0,
+    "stuck_iterations": 20,
 }
 """The servo's settling and rest settings: those every push used before they were chosen
 per controller. The servo keeps them, so that its plans, goldens and measurements stay
-reproducible bit for bit (``docs/design/physics.md``)."""
+reproducible bit for bit (``docs/design/physics.md``); so it never raises its solver
+iterations for a push that is slow to rest."""
 
 COMPLIANT_VALUES: dict[str, float | int] = {
     "iterations": 5,
@@ -169,11 +188,14 @@ COMPLIANT_VALUES: dict[str, float | int] = {
     "rest_angular_tol": 1.25e-4,
     "rest_checks": 2,
     "sleep_time": 0.05,
+    "stuck_time": 1.0,
+    "stuck_iterations": 20,
 }
 """The compliant controller's settling and rest settings, chosen on the accuracy benchmark
 (``benchmarks/push_accuracy.py``; the alternatives measured are in ``docs/design/physics.md``):
 a check every 3 steps (0.0125 s) with the old speed threshold (1.25e-4 in per check is the old
-1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep. About
+1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep; a push
+not at rest 1 s after its set point's end is solved at 20 iterations from then on. About
 0.7x the steps and 0.55-0.6x the time of the servo's values, final poses as close to the
 reference."""
 

@@ -140,8 +140,12 @@ checks in a row; the push ends when every other body was still ``rest_checks`` c
 at least one of them after the drive stopped (the other bodies are watched from the first
 check at which the paddle is still, so the check that stops the drive can count: that saves
 one interval per push and still ends every push with two consecutive still checks of every
-body). The whole push is capped at ``max_time`` (20 s) of simulated time; a cap hit is reported
-as ``NOT_AT_REST`` with the poses at the cap, never silently truncated.
+body). A compliant push not at rest ``stuck_time`` (1 s) after its set point's end is solved
+with ``stuck_iterations`` (20) from then on: a paddle that has turned and presses a tilted part
+into a wall or a post wedges it, and at 5 or 10 iterations that wedge chatters until the cap
+(the servo keeps its iterations throughout). The whole push is capped at ``max_time`` (20 s) of
+simulated time; a cap hit is reported as ``NOT_AT_REST`` with the poses at the cap, never
+silently truncated.
 
 These rest settings, the solver ``iterations`` and body sleeping (``sleep_time``: bodies idle
 that long are no longer solved until something touches them) are chosen per controller
@@ -579,7 +583,18 @@ def _push(
         last = None
         last_x, last_y = px, py
         travel = 0.0
+        # A push still not at rest `stuck_time` after its set point's end gets more solver
+        # iterations: chatter of a wedged contact, which more iterations settle (settings).
+        if s.stuck_time > 0.0:
+            speed = s.push_speed if controller.speed is None else controller.speed
+            setpoint_end = distance / (track.speed if compliant else speed)
+            stuck_at = math.ceil((setpoint_end + s.stuck_time) / dt)
+        else:
+            stuck_at = max_steps + 1
         while True:
+            if steps >= stuck_at:
+                lib.cpSpaceSetIterations(space, s.stuck_iterations)
+                stuck_at = max_steps + 1
             if steps + interval > max_steps:
                 if driving:
                     advance(max_steps - steps)

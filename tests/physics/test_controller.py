@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -19,11 +20,13 @@ from arrange_up.model.problem import (
     ObjectKind,
     problem_hash,
 )
-from arrange_up.model.world import ActionNoise, WorldState
+from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.physics.bench import scene
-from arrange_up.physics.simulation import simulate, simulate_watched
+from arrange_up.physics.settings import DEFAULT_SETTINGS
+from arrange_up.physics.simulation import StepStatus, simulate, simulate_watched
 
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
+FRESH = Path(__file__).resolve().parents[1] / "problems" / "fresh"
 
 
 def _noise(friction: float = 0.4, density: float = 0.125) -> ActionNoise:
@@ -154,3 +157,26 @@ def test_plan_files_record_the_controller():
     assert plan_document(servo, (), **kw)["controller"] == {"kind": "servo", "speed": 2.54}
     recorded = plan_document(compliant, (), **kw)["controller"]
     assert recorded == {"kind": "compliant", "kp": 300.0, "speed": 2.54}  # in the file's cm
+
+
+def test_a_wedged_compliant_push_comes_to_rest_with_more_solver_iterations():
+    # A rollout of squeeze-post's plan: the paddle, turned by its approach noise, presses the
+    # tilted block into the bottom wall. At 5 solver iterations the wedge chatters (the paddle
+    # oscillates by about 0.03 in) until the 20 s cap; raised to 20 after 1 s past the set
+    # point's end, it settles in under 2.5 s with the block where it was pressed.
+    problem = load(FRESH / "squeeze-post.yaml")
+    state = WorldState((("A", (5.4344524222650294, 0.5620389201441705, 0.14044835920831922)),))
+    push = Push("paddle", (4.627788, 1.54475, math.radians(-180.0)), 1.4697)
+    noise = ActionNoise(
+        pose_offset=(-0.005267972242585572, -0.09738029668683373, -0.03337826740161486),
+        friction=0.624535399920112,
+        part_density=0.125,
+        manipulator_density=0.4,
+    )
+    settled = simulate(problem, state, push, noise)
+    assert settled.status is StepStatus.OK
+    assert settled.sim_time < 2.5
+    x, y, _ = settled.state.as_dict()["A"]
+    assert abs(x - 5.41) < 0.02 and abs(y - 0.59) < 0.02
+    chattering = simulate(problem, state, push, noise, replace(DEFAULT_SETTINGS, stuck_time=0.0))
+    assert chattering.status is StepStatus.NOT_AT_REST
