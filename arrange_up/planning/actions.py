@@ -64,8 +64,9 @@ such a push cannot help it, and it multiplies the search's plateaus.
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
 against there), places of a fixture at the part's goal face, after the places of parts; a push
 to a fence on the table, as to a wall; and along that axis no push that ends in the open (to
-the goal coordinate, or narrowing) while a fence stands there or can be put down. Nothing of
-this is offered for a problem whose parts need no fence (every shipped problem).
+the goal coordinate, or narrowing) while a fence stands there or can be put down; and for
+such a part, the manipulator centred across so that its path misses the fixtures on the table.
+Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
 
 **Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
 part at its goal while the part still misses its goal along the other axis; parts are never
@@ -355,8 +356,29 @@ class ActionGenerator:
         distances = self._distances(
             name, interval, belief, axis, sign, front_nominal, ladder, routes or {}
         )
+        centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table)
+        if self.fences.needs and distances:
+            # a fence for the other axis may stand in the manipulator's path (planning.fences)
+            other = 1 - axis
+            reach = 0.5 * manip.length - 0.1
+            low_lim, high_lim = self._across_limits(other)
+            span = (
+                max(interval.center[other] - reach, low_lim - m_box[other]),
+                min(interval.center[other] + reach, high_lim - m_box[other + 2]),
+            )
+            centres = self.fences.clear_paths(
+                name,
+                belief,
+                axis,
+                sign,
+                centres,
+                span,
+                (along + m_box[axis], along + m_box[axis + 2]),
+                (m_box[other], m_box[other + 2]),
+                max(d for d, _ in distances),
+            )
         pushes = []
-        for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
+        for across in centres:
             pose = (along, across, theta) if axis == 0 else (across, along, theta)
             if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
                 for d, travel in distances:
