@@ -64,7 +64,8 @@ such a push cannot help it, and it multiplies the search's plateaus.
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
 against there), places of a fixture at the part's goal face, after the places of parts; a push
 to a fence on the table, as to a wall; and along that axis no push that ends in the open (to
-the goal coordinate, or narrowing) while a fence stands there or can be put down; and for
+the goal coordinate, or narrowing) while a fence stands there or can be put down, but for a
+levelling push where a corner needs the part brought level with its other fence first; and for
 such a part, the manipulator centred across so that its path misses the fixtures on the table.
 Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
 
@@ -495,7 +496,7 @@ class ActionGenerator:
         # that end in the open along this axis are not offered: by the problem's own noise
         # they cannot stop the part within its tolerance (planning.fences).
         target = self.place_target(name, belief)
-        fenced = False
+        fenced, levelling = False, None
         if self.fences.needs and name in self.fences.goal_boxes:
             face = self.fences.face_ahead(name, interval, belief, axis, sign)
             if face is not None and not (
@@ -508,6 +509,9 @@ class ActionGenerator:
             fenced = self.fences.needed(name, axis) and (
                 face is not None or (name, axis, sign) in (routes or {})
             )
+            if fenced:
+                # a corner: the part first brought level with a fence of the other axis
+                levelling = self.fences.level(name, interval, belief, axis, routes or {})
         stall = self._stall(name, belief, axis, sign) if self.stall_per_area else 0.0
         travels: dict[float, float | None] = dict.fromkeys(candidates)
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
@@ -517,7 +521,12 @@ class ActionGenerator:
             travel = sign * (target[axis] - interval.center[axis])
             half = interval.half[axis]
             if fenced:
-                pass  # the fence's push (above) replaces those that end in the open
+                # the fence's push (above) replaces those that end in the open, but for a
+                # levelling push
+                if levelling is not None:
+                    level = sign * (levelling - interval.center[axis])
+                    if level > MIN_PUSH:
+                        travels.setdefault(gap + level + stall, level)
             elif travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
             elif not self._inside_goal(interval, target, axis) and travel + half > MIN_PUSH:

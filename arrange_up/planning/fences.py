@@ -21,7 +21,10 @@ Only problems with fixtures and an absolute goal can need one, and no shipped pr
 **Where a fence goes** (:meth:`Fences.placements`): from the goal, each fixture off the table,
 at each of its distinct right-angle turns (:func:`fixture_angles`, the repair's grid angles),
 with its near face flush with the goal footprint's face on the side the part is pushed
-towards, so that the part pressed against it ends at its target. Across the push its footprint
+towards, so that the part pressed against it ends at its target (for a part that goal parts
+touch ahead in a row, the face of the row's last part, :meth:`Fences.train`: the part presses
+the row against the fence, as a wall train is pressed against its wall; the row must be on
+the table for that push). Across the push its footprint
 covers the part's goal coordinate with ``COVER`` of the part's width to spare on either side
 (the part must be held there at the end), its place shadow ``GAP`` from the table's edges and
 walls: centred on the goal's coordinate as far as that allows, and as near the part's present
@@ -39,6 +42,13 @@ within the tolerance of the part's goal face, ahead of the part's shadow, and wh
 footprint covers the part's centre across the push (as above), is offered as the wall is: a
 push to the face (the compliant controller's set point then lies beyond it, and the force clip
 presses the part against it).
+
+**Levelling** (:meth:`Fences.level`): where both axes need a fence and no fence of the other
+axis stands, or can stand, in front of the part (its footprint would not cover the part's
+centre across), the generator offers, along this axis, the one push that ends in the open: to
+the nearest coordinate such a fence would cover, with that push's own end spread inside. The
+corner is built from there: the part pressed against that fence and slid along it onto the
+fence of this axis.
 
 **Keeping the manipulator's path clear** (:meth:`Fences.clear_paths`): the approach shadow is
 checked where a push starts, but a manipulator centred on the part would run into a fence of
@@ -118,6 +128,7 @@ class Fences:
         self.goal_boxes: dict[str, tuple[float, ...]] = {}
         #: (part, axis) -> the free push's end spread, for the axes that need a fence.
         self.needs: dict[tuple[str, int], float] = {}
+        self._trains: dict[tuple[str, int, int], tuple[str, ...]] = {}
         if goal.is_relative or not problem.fixtures:
             return
         spread = stall_spread(problem)
@@ -135,14 +146,93 @@ class Fences:
                 if free > tolerance > fence and not held_by_wall.get((part, axis), False):
                     self.needs[(part, axis)] = free
 
+    def level(
+        self,
+        part: str,
+        interval,
+        belief: IntervalBelief,
+        axis: int,
+        routes: dict[tuple[str, int, int], list[Place]],
+    ) -> float | None:
+        """Where a *levelling* push along ``axis`` takes ``part``'s centre, or None when none
+        is needed: the part needs a fence along the other axis too, no fence for that axis
+        (on the table, or among ``routes``) stands in front of the part now, and one would if
+        the part were moved along ``axis`` to the nearest coordinate it covers (with ``COVER``
+        of the part to spare, and the levelling push's own end spread, the free push's along
+        ``axis``, inside that). A corner is built from there: the part pressed against that
+        fence and slid along it onto the fence of this axis."""
+        other = 1 - axis
+        if not self.needed(part, axis) or not self.needed(part, other):
+            return None
+        target = self.problem.goal.target(part)
+        if (
+            abs(interval.center[other] - target[other]) + interval.half[other]
+            <= (self.problem.goal.tolerance[other])
+        ):
+            return None  # within its goal along the other axis: no fence needed there now
+        sign = 1 if target[other] > interval.center[other] else -1
+        boxes = [
+            self.checker.shadow_box(place.obj, place.pose, _ZERO)
+            for place in routes.get((part, other, sign), ())
+        ]
+        goal_face = self.goal_face(part, other, sign)
+        tolerance = self.problem.goal.tolerance[other]
+        for spec in self.problem.fixtures:
+            fixture = belief.get(spec.name)
+            if fixture is not None:
+                box = self.checker.shadow_box(spec.name, fixture.center, _ZERO)
+                if abs((box[other] if sign > 0 else box[other + 2]) - goal_face) <= tolerance:
+                    boxes.append(box)
+        goal_box = self.goal_boxes[part]
+        spare = COVER * (goal_box[axis + 2] - goal_box[axis])
+        centre = interval.center[axis]
+        if any(b[axis] + spare <= centre + 1e-9 <= b[axis + 2] - spare + 2e-9 for b in boxes):
+            return None  # level with a fence already
+        inset = spare + self.needs[(part, axis)]
+        best = None
+        for box in boxes:
+            low, high = box[axis] + inset, box[axis + 2] - inset
+            if low <= high:
+                at = _clamp(centre, low, high)
+                if best is None or abs(at - centre) < abs(best - centre):
+                    best = at
+        return best
+
     def needed(self, part: str, axis: int) -> bool:
         return (part, axis) in self.needs
 
     def goal_face(self, part: str, axis: int, sign: int) -> float:
-        """The coordinate of ``part``'s goal footprint's face on the ``sign`` side along
-        ``axis``."""
-        box = self.goal_boxes[part]
+        """Where a fence holding ``part`` pushed along ``axis`` towards ``sign`` stands: the
+        goal footprint's face on that side of the last part of its goal train (the part
+        itself when no goal part touches it ahead; :meth:`train`)."""
+        end = self.train(part, axis, sign)[-1:] or (part,)
+        box = self.goal_boxes[end[0]]
         return box[axis + 2] if sign > 0 else box[axis]
+
+    def train(self, part: str, axis: int, sign: int) -> tuple[str, ...]:
+        """The goal parts ahead of ``part`` along ``axis`` towards ``sign`` that touch in a row
+        in the goal arrangement (within twice the tolerance): pushed, the part presses them
+        against the fence, as a wall train is pressed against its wall."""
+        key = (part, axis, sign)
+        if key not in self._trains:
+            slack = 2.0 * max(self.problem.goal.tolerance[:2]) + 1e-6
+            other = 1 - axis
+            box, train = self.goal_boxes[part], [part]
+            while True:
+                front = box[axis + 2] if sign > 0 else -box[axis]
+                ahead = [
+                    q
+                    for q, b in self.goal_boxes.items()
+                    if q not in train
+                    and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
+                    and abs((b[axis] if sign > 0 else -b[axis + 2]) - front) <= slack
+                ]
+                if not ahead:
+                    break
+                train.append(ahead[0])
+                box = self.goal_boxes[ahead[0]]
+            self._trains[key] = tuple(train[1:])
+        return self._trains[key]
 
     # -- where fences go -----------------------------------------------------------------------
     def placements(
@@ -329,8 +419,10 @@ class Fences:
         """A fixture on the table (and its near face) whose near face, seen from ``part``
         pushed along ``axis`` towards ``sign``, lies within the tolerance of the part's goal
         face, and whose footprint covers the part's centre across the push."""
-        if part not in self.goal_boxes:
-            return None
+        if part not in self.goal_boxes or any(
+            q not in belief for q in self.train(part, axis, sign)
+        ):
+            return None  # its train (if any) must be on the table to be pressed against it
         goal_face = self.goal_face(part, axis, sign)
         tolerance = self.problem.goal.tolerance[axis]
         other = 1 - axis

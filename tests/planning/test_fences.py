@@ -138,6 +138,43 @@ def test_the_planner_builds_a_corner_whose_fences_hold_the_block_at_its_goal(ope
     assert set(result.actions[-2:]) == {Pick("bar1"), Pick("bar2")}
 
 
+def test_a_part_no_fence_can_stand_in_front_of_yet_is_first_brought_level_with_one():
+    # fence-middle-corner: A (1.2 x 0.8 in) from (9, 2.5) to (5, 6); both axes need a fence.
+    # A 3 in bar at A's goal face x 4.4 must cover A's goal y (6) with a quarter of A to
+    # spare, so it stands at y 4.7 at the lowest and covers y 3.2..6.2: A at y 2.5 is in
+    # front of no such bar, and pushes along x would leave any fence of y behind.
+    problem = load_problem(FRESH / "fence-middle-corner.yaml")
+    gen = _generator(problem)
+    start = ("A", ObjectInterval((9.0, 2.5, 0.0), (0.25, 0.25, 0.09)))
+    belief = IntervalBelief((start,))
+    routes = gen.fence_routes(belief)
+    # up to where that bar covers A, with A's own free push end spread (0.15 in) inside it
+    level = gen.fences.level("A", start[1], belief, 1, routes)
+    assert level == pytest.approx(3.2 + 0.2 + 0.12 + 0.0322 * 0.96, abs=1e-3)
+    ups = [p for p in gen.pushes(belief) if abs(p.pose[2]) < 1e-3]
+    assert len(ups) == 1  # the levelling push: no other push that ends in the open along y
+    # once level, no levelling push: the fences' own pushes take over
+    there = ("A", ObjectInterval((9.0, level, 0.0), (0.25, 0.15, 0.09)))
+    assert gen.fences.level("A", there[1], IntervalBelief((there,)), 1, routes) is None
+
+
+def test_a_row_is_pressed_against_one_fence_at_its_last_part():
+    # fence-row: A (goal x 5.5) touches B (6.5) ahead of it; a fence at A's own goal face
+    # (x 6) would stand on B's goal, so A's fence is B's, at x 7, through the row
+    problem = load_problem(FRESH / "fence-row.yaml")
+    gen = _generator(problem)
+    assert set(gen.fences.needs) == {("A", 0), ("B", 0)}  # the bottom wall holds y
+    assert gen.fences.train("A", 0, 1) == ("B",)
+    assert gen.fences.goal_face("A", 0, 1) == pytest.approx(7.0)
+    low = ("A", ObjectInterval((3.0, 0.55, 0.0), (0.1, 0.05, 0.05)))
+    bar = ("bar", ObjectInterval((7.15, 1.304473, 0.0), (0.03, 0.03, 0.035)))
+    # pressed against the bar only once B, the row's last part, is on the table
+    assert gen.fences.face_ahead("A", low[1], IntervalBelief((low, bar)), 0, 1) is None
+    high = ("B", ObjectInterval((2.0, 4.5, 0.0), (0.1, 0.1, 0.05)))
+    belief = IntervalBelief((low, high, bar))
+    assert gen.fences.face_ahead("A", low[1], belief, 0, 1) == pytest.approx(7.0)
+
+
 def test_a_fixture_put_down_must_be_picked_up_before_the_goal_is_reached(corner):
     goal = GoalTest(corner)
     at_goal = {"A": (6.0, 0.5, 0.0)}
