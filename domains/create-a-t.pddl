@@ -41,5 +41,7 @@
     (>= (rel-x stem top) (- 0.25)) (<= (rel-x stem top) 0.25)
     (>= (rel-y stem top) (- 2.25)) (<= (rel-y stem top) (- 1.75))
     (>= (rel-theta stem top) (- 10)) (<= (rel-theta stem top) 10)
+    ; fixtures that start off the table end off it (a fence put down is picked up)
+    (not (on-table bar))
   ))
 )

@@ -39,5 +39,7 @@
     (>= (x block) 4.75) (<= (x block) 7.25)
     (>= (y block) 2.5) (<= (y block) 3.5)
     (>= (theta block) (- 15)) (<= (theta block) 15)
+    ; fixtures that start off the table end off it (a fence put down is picked up)
+    (not (on-table bar))
   ))
 )

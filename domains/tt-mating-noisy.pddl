@@ -45,5 +45,7 @@
     (>= (rel-x T2 T1) 0.8) (<= (rel-x T2 T1) 1.2)
     (>= (rel-y T2 T1) (- 2)) (<= (rel-y T2 T1) (- 1.6))
     (>= (rel-theta T2 T1) 170) (<= (rel-theta T2 T1) 190)
+    ; fixtures that start off the table end off it (a fence put down is picked up)
+    (not (on-table bar))
   ))
 )

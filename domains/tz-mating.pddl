@@ -45,5 +45,7 @@
     (>= (rel-x Z T) 1.3) (<= (rel-x Z T) 1.7)
     (>= (rel-y Z T) (- 0.6)) (<= (rel-y Z T) (- 0.2))
     (>= (rel-theta Z T) 80) (<= (rel-theta Z T) 100)
+    ; fixtures that start off the table end off it (a fence put down is picked up)
+    (not (on-table bar))
   ))
 )

@@ -65,9 +65,7 @@ class GoalTest:
             [symmetry_period(problem.object(p).shape) for p in self.parts], dtype=float
         )
         #: Fixtures that start off the table, and so must end off it (module docstring).
-        self.put_away: frozenset[str] = frozenset(
-            spec.name for spec in problem.fixtures if problem.initial_of(spec.name) is None
-        )
+        self.put_away: frozenset[str] = frozenset(problem.put_away)
 
     # -- coordinates ---------------------------------------------------------------------------
     def coordinates(self, poses: np.ndarray, names: Sequence[str]) -> np.ndarray | None:

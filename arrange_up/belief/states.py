@@ -12,7 +12,8 @@ Angles. A shape that looks the same after a rotation by ``2*pi/k`` (a square: k 
 physically identical poses ``theta`` and ``theta + 2*pi/k``; pymunk happily reports either.
 Every belief therefore stores angles *canonically*: wrapped into the half-open period
 ``[ref - period/2, ref + period/2)`` around the object's reference angle (its absolute goal
-angle if it has one, else its initial angle if it starts on the table, else 0).
+angle if it has one, else its initial angle if it starts on the table, else for a fixture the
+middle of the turns it is placed at, :func:`fixture_turns`, else 0).
 :func:`symmetry_period` finds the period from the geometry.
 """
 
@@ -50,6 +51,13 @@ def symmetry_period(shape: Shape) -> float:
     return TWO_PI
 
 
+def fixture_turns(shape: Shape) -> tuple[float, ...]:
+    """The distinct right-angle turns (0 and 90 degrees, fewer for a shape that looks the same
+    turned) at which the planner's fences and the repair's grid place a fixture, ascending."""
+    period = symmetry_period(shape)
+    return tuple(sorted({round(a % period, 9) for a in (0.0, 0.5 * math.pi)}))
+
+
 def wrap_angle(theta: float, reference: float, period: float) -> float:
     """``theta`` shifted by a multiple of ``period`` into ``[reference - period/2,
     reference + period/2)``."""
@@ -79,6 +87,12 @@ class AngleFrame:
                 # Centre the period on where the object starts: wrapping at the start angle
                 # itself would split one belief across the period's two ends.
                 reference[spec.name] = initial.pose[2]
+            elif spec.kind is ObjectKind.FIXTURE:
+                # A bar (period 180 degrees) is placed at 0 and at 90 degrees: wrapped around 0
+                # the second would split across the period's ends (-90 and +90 degrees, one
+                # belief spanning every angle); the middle of its turns keeps both inside.
+                turns = fixture_turns(spec.shape)
+                reference[spec.name] = 0.5 * (turns[0] + turns[-1])
             else:
                 reference[spec.name] = 0.0
         return cls(reference, period)

@@ -34,7 +34,12 @@ dimension: ``(>= (x P) lo) (<= (x P) hi)`` and likewise ``y`` and, unless any an
 ``theta``; or, for a relative goal, the same on ``(rel-x P R)``, ``(rel-y P R)``,
 ``(rel-theta P R)`` with one reference part ``R``. Every goal part must have the same
 half-widths (the problem has one tolerance). Angles are understood modulo the part's rotational
-symmetry (a square block turned 90 degrees is the same block).
+symmetry (a square block turned 90 degrees is the same block). The goal also states the
+format's put-away rule: ``(not (on-table F))`` for each fixture ``F`` that starts off the table
+(it must end off it: a fence put down is picked up). The rule holds whether a file states it
+or not (a file written before it was stated reads as before); the reader refuses
+``(not (on-table X))`` for anything else (a part, or a fixture that starts on the table, which
+may stay) and ``(on-table F)`` for such a fixture.
 
 **Units.** PDDL files are always in **inches and degrees** (the YAML format's defaults; degrees
 keep angles like 15 or 90 exact). Numbers are read exactly (``Fraction``) and converted once.

@@ -294,6 +294,9 @@ class _Builder:
     source: str
     located: _Text | None
     diagnostics: list[Diagnostic] = field(default_factory=list)
+    #: The goal's ``(on-table X)`` and ``(not (on-table X))`` conditions, as
+    #: ``("on-table" | "off-table", X)`` (:meth:`check_put_away`).
+    table_goals: list[tuple[str, str]] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.catalogue = load_catalogue()
@@ -322,6 +325,7 @@ class _Builder:
         uncertainty = self.uncertainty(values)
         initial, obstacles = self.poses(values, kinds)
         goal = self.goal(kinds)
+        self.check_put_away(kinds, {entry.name for entry in initial})
         if any(d.is_error for d in self.diagnostics):
             return None
         assert table is not None and uncertainty is not None and goal is not None
@@ -590,7 +594,8 @@ class _Builder:
             if parsed is None:
                 ok = False
                 continue
-            if parsed == "on-table":
+            if parsed[0] in ("on-table", "off-table"):
+                self.table_goals.append(parsed)
                 continue
             function, part, reference, low, high = parsed
             functions_used.add(function)
@@ -728,9 +733,14 @@ class _Builder:
         )
 
     def goal_condition(self, condition: Any) -> Any:
-        """``"on-table"``, ``(function, part, reference, low, high)`` or ``None`` (reported)."""
+        """``("on-table", name)``, ``("off-table", name)`` (for ``(not (on-table name))``),
+        ``(function, part, reference, low, high)`` or ``None`` (reported)."""
         if condition.is_fluent_exp() and condition.fluent().name == "on-table":
-            return "on-table"
+            return "on-table", self.name(condition.args[0].object().name)
+        if condition.is_not():
+            (inner,) = condition.args
+            if inner.is_fluent_exp() and inner.fluent().name == "on-table":
+                return "off-table", self.name(inner.args[0].object().name)
         if condition.is_le() or condition.is_lt() or condition.is_equals():
             # a bound written (- 0.6) is an expression to UP: simplify it to its number
             left, right = (arg.simplify() for arg in condition.args)
@@ -760,9 +770,41 @@ class _Builder:
             "goal",
             r"\(\s*:goal",
             f"unsupported goal condition {condition}; expected (on-table P), (>= (x P) lo), "
-            "(<= (x P) hi) and likewise y, theta, or rel-x/rel-y/rel-theta of (P R)",
+            "(<= (x P) hi) and likewise y, theta, or rel-x/rel-y/rel-theta of (P R), or "
+            "(not (on-table F)) for a fixture F that starts off the table",
         )
         return None
+
+    def check_put_away(self, kinds: dict[str, ObjectKind], initial: set[str]) -> None:
+        """The goal's ``(not (on-table F))`` states the format's rule that a fixture starting
+        off the table ends off it (the rule holds whether the goal states it or not): it may
+        name only such a fixture, and no ``(on-table F)`` may contradict the rule."""
+        for condition, name in self.table_goals:
+            put_away = kinds.get(name) is ObjectKind.FIXTURE and name not in initial
+            if condition == "off-table" and not put_away:
+                kind = kinds.get(name)
+                what = (
+                    "not an object"
+                    if kind is None
+                    else "a fixture that starts on the table (it may stay)"
+                    if kind is ObjectKind.FIXTURE
+                    else f"a {kind.value}"
+                )
+                self.error(
+                    f"goal.{name}",
+                    rf"\(\s*not\s+\(\s*on-table\s+{re.escape(name)}\s*\)",
+                    f"(not (on-table {name})): {name} is {what}; a goal can require off the "
+                    "table only a fixture that starts off it (and every such fixture must end "
+                    "off it, stated or not)",
+                )
+            elif condition == "on-table" and put_away:
+                self.error(
+                    f"goal.{name}",
+                    rf"\(\s*on-table\s+{re.escape(name)}\s*\)",
+                    f"(on-table {name}): {name} is a fixture that starts off the table, and "
+                    f"such a fixture must end off it; expected (not (on-table {name})) or no "
+                    "condition on it",
+                )
 
     def check_goal_on_table(self, problem: ArrangementProblem) -> None:
         """An absolute goal whose part cannot be on the table is an error; one whose part

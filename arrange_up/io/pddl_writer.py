@@ -179,6 +179,11 @@ def _render(problem: ArrangementProblem, types: dict[str, str]) -> str:
         lines.append("    " + _interval(fy, ty, tol_y))
         if tol_theta is not None:
             lines.append("    " + _interval(ftheta, deg(ttheta), deg(tol_theta)))
+    if problem.put_away:
+        lines.append(
+            "    ; fixtures that start off the table end off it (a fence put down is picked up)"
+        )
+        lines.append("    " + " ".join(f"(not (on-table {name}))" for name in problem.put_away))
     lines += ["  ))", ")", ""]
     return "\n".join(lines)
 

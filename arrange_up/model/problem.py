@@ -302,6 +302,13 @@ class ArrangementProblem:
     def obstacles(self) -> tuple[ObjectSpec, ...]:
         return self.of_kind(ObjectKind.OBSTACLE)
 
+    @property
+    def put_away(self) -> tuple[str, ...]:
+        """The fixtures that start off the table, in declaration order: the format's rule is
+        that they must be off it again when the goal is reached (a fence put down is picked
+        up); a fixture that starts on the table may stay."""
+        return tuple(spec.name for spec in self.fixtures if self.initial_of(spec.name) is None)
+
 
 def driven_by(problem: ArrangementProblem, kind: ControllerKind | str) -> ArrangementProblem:
     """``problem`` driven by a controller of ``kind`` (``"compliant"`` or ``"servo"``):

@@ -86,8 +86,10 @@ but for a detour: such a push cannot help it, and it multiplies the search's pla
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
 against there), places of a fixture at the part's goal face, after the places of parts; a push
 to a fence on the table, as to a wall; and along that axis no push that ends in the open (to
-the goal coordinate, or narrowing) while a fence stands there or can be put down. Nothing of
-this is offered for a problem whose parts need no fence (every shipped problem).
+the goal coordinate, or narrowing) while a fence stands there or can be put down, but for a
+levelling push where a corner needs the part brought level with its other fence first; and for
+such a part, the manipulator centred across so that its path misses the fixtures on the table.
+Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
 
 **Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
 part at its goal while the part still misses its goal along the other axis; parts are never
@@ -471,6 +473,10 @@ class ActionGenerator:
                 )
             if sweep and not centres:
                 centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table)
+            if self.fences.needs and group:
+                centres = self._clear_of_fences(
+                    manip, name, interval, belief, axis, sign, along, m_box, centres, group
+                )
             for across in centres:
                 pose = (along, across, theta) if axis == 0 else (across, along, theta)
                 if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
@@ -483,6 +489,31 @@ class ActionGenerator:
                         if d in jammed and jams is not None:
                             jams.append(push)
         return pushes
+
+    def _clear_of_fences(
+        self, manip, name, interval, belief, axis, sign, along, m_box, centres, distances
+    ) -> list[float]:
+        """``centres`` moved so that the manipulator's path misses the fences of the other axis
+        on the table (:meth:`~arrange_up.planning.fences.Fences.clear_paths`), for a part that
+        needs a fence."""
+        other = 1 - axis
+        reach = 0.5 * manip.length - 0.1
+        low_lim, high_lim = self._across_limits(other)
+        span = (
+            max(interval.center[other] - reach, low_lim - m_box[other]),
+            min(interval.center[other] + reach, high_lim - m_box[other + 2]),
+        )
+        return self.fences.clear_paths(
+            name,
+            belief,
+            axis,
+            sign,
+            centres,
+            span,
+            (along + m_box[axis], along + m_box[axis + 2]),
+            (m_box[other], m_box[other + 2]),
+            max(d for d, _ in distances),
+        )
 
     def _sweeps(self, distances, along, m_box, part_box, axis, sign):
         """``distances`` grouped by the obstacles the paddle's approach shadow would sweep into
@@ -633,7 +664,7 @@ class ActionGenerator:
         # that end in the open along this axis are not offered: by the problem's own noise
         # they cannot stop the part within its tolerance (planning.fences).
         target = self.place_target(name, belief)
-        fenced = False
+        fenced, levelling = False, None
         if self.fences.needs and name in self.fences.goal_boxes:
             face = self.fences.face_ahead(name, interval, belief, axis, sign)
             if face is not None and not (
@@ -646,6 +677,9 @@ class ActionGenerator:
             fenced = self.fences.needed(name, axis) and (
                 face is not None or (name, axis, sign) in (routes or {})
             )
+            if fenced:
+                # a corner: the part first brought level with a fence of the other axis
+                levelling = self.fences.level(name, interval, belief, axis, routes or {})
         travels: dict[float, float | None] = dict.fromkeys(candidates)
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
         # a narrowing push, to the contact of the rearmost state.
@@ -655,7 +689,12 @@ class ActionGenerator:
             travel = sign * (target[axis] - interval.center[axis])
             half = interval.half[axis]
             if fenced:
-                pass  # the fence's push (above) replaces those that end in the open
+                # the fence's push (above) replaces those that end in the open, but for a
+                # levelling push
+                if levelling is not None:
+                    level = sign * (levelling - interval.center[axis])
+                    if level > MIN_PUSH:
+                        travels.setdefault(gap + level + stall, level)
             elif travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
             elif not self._inside_goal(interval, target, axis) and travel + half > MIN_PUSH:

@@ -21,21 +21,45 @@ Only problems with fixtures and an absolute goal can need one, and no shipped pr
 **Where a fence goes** (:meth:`Fences.placements`): from the goal, each fixture off the table,
 at each of its distinct right-angle turns (:func:`fixture_angles`, the repair's grid angles),
 with its near face flush with the goal footprint's face on the side the part is pushed
-towards, so that the part pressed against it ends at its target. Across the push it is centred
-on the goal's coordinate and on the part's present one (its swath: where a push along the axis
-moves it) when they differ, each moved as little as keeps the fixture's place shadow on the
-table (``GAP`` from its edges and walls) while its footprint still covers the part's centre
-with ``COVER`` of the part's width to spare on either side; and at either end of that range
-(where it clears another fence: two fences make a corner). The place precondition is the
-planner's (the fixture's place shadow on the table, touching no shadow, wall or obstacle).
-Offered only for a part that needs the fence, is not already within its goal along the axis,
-and would not be pushed away from its goal (the push rule of :mod:`arrange_up.planning.actions`).
+towards, so that the part pressed against it ends at its target (for a part that goal parts
+touch ahead in a row, the face of the row's last part, :meth:`Fences.train`: the part presses
+the row against the fence, as a wall train is pressed against its wall; the row must be on
+the table for that push). Across the push its footprint
+covers the part's goal coordinate with ``COVER`` of the part's width to spare on either side
+(the part must be held there at the end), its place shadow ``GAP`` from the table's edges and
+walls: centred on the goal's coordinate as far as that allows, and as near the part's present
+coordinate as it can (a fence that covers the part there too presses it now, and the part
+slides along it to its goal: a corner of two fences is built so, one pressed, the other slid
+onto, the first pressed again); only where neither stands, at either end of that range (clear
+of another fence). A fence centred on the part's present coordinate alone would be left
+behind by the pushes still to come. The place precondition is the planner's (the fixture's
+place shadow on the table, touching no shadow, wall or obstacle). Offered only for a part that
+needs the fence, is not already within its goal along the axis, and would not be pushed away
+from its goal (the push rule of :mod:`arrange_up.planning.actions`).
 
 **Using it** (:meth:`Fences.face_ahead`): any fixture on the table whose near face lies
 within the tolerance of the part's goal face, ahead of the part's shadow, and whose nominal
 footprint covers the part's centre across the push (as above), is offered as the wall is: a
 push to the face (the compliant controller's set point then lies beyond it, and the force clip
 presses the part against it).
+
+**Levelling** (:meth:`Fences.level`): where both axes need a fence and no fence of the other
+axis stands, or can stand, in front of the part (its footprint would not cover the part's
+centre across), the generator offers, along this axis, the one push that ends in the open: to
+the nearest coordinate such a fence would cover, with that push's own end spread inside. The
+corner is built from there: the part pressed against that fence and slid along it onto the
+fence of this axis.
+
+**Keeping the manipulator's path clear** (:meth:`Fences.clear_paths`): the approach shadow is
+checked where a push starts, but a manipulator centred on the part would run into a fence of
+the other axis standing beside the part's path (the first fence of a corner) and stall there;
+for a part that needs a fence, a centre whose path meets a fixture on the table is moved to
+the nearest that misses them all while still covering the part's centre.
+
+A bar placed at 90 degrees is one belief of angles around 90 degrees
+(:func:`~arrange_up.belief.states.fixture_turns` centres a fixture's angle period on its
+turns); wrapped around 0 its particles would lie at both ends of the period, the bar would be
+seen at 0 degrees, and no push would take it for a fence.
 """
 
 from __future__ import annotations
@@ -43,7 +67,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from arrange_up.belief.states import IntervalBelief, symmetry_period
+from arrange_up.belief.states import IntervalBelief, fixture_turns
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import STANDARD_GRAVITY, ArrangementProblem, ControllerKind, Pose
 from arrange_up.model.world import Place
@@ -62,11 +86,14 @@ def _round(value: float) -> float:
     return round(float(value), 6) + 0.0
 
 
+def _clamp(value: float, low: float, high: float) -> float:
+    return min(max(value, low), high)
+
+
 def fixture_angles(problem: ArrangementProblem, name: str) -> list[float]:
-    """The distinct right-angle turns (0 and 90 degrees, fewer for a fixture that looks the
-    same turned) at which fixture ``name`` is placed: by the repair's grid and by fences."""
-    period = symmetry_period(problem.object(name).shape)
-    return sorted({round(a % period, 9) for a in (0.0, 0.5 * math.pi)})
+    """The distinct right-angle turns at which fixture ``name`` is placed, by the repair's grid
+    and by fences (:func:`~arrange_up.belief.states.fixture_turns`)."""
+    return list(fixture_turns(problem.object(name).shape))
 
 
 def stall_spread(problem: ArrangementProblem) -> float:
@@ -101,6 +128,7 @@ class Fences:
         self.goal_boxes: dict[str, tuple[float, ...]] = {}
         #: (part, axis) -> the free push's end spread, for the axes that need a fence.
         self.needs: dict[tuple[str, int], float] = {}
+        self._trains: dict[tuple[str, int, int], tuple[str, ...]] = {}
         if goal.is_relative or not problem.fixtures:
             return
         spread = stall_spread(problem)
@@ -118,14 +146,93 @@ class Fences:
                 if free > tolerance > fence and not held_by_wall.get((part, axis), False):
                     self.needs[(part, axis)] = free
 
+    def level(
+        self,
+        part: str,
+        interval,
+        belief: IntervalBelief,
+        axis: int,
+        routes: dict[tuple[str, int, int], list[Place]],
+    ) -> float | None:
+        """Where a *levelling* push along ``axis`` takes ``part``'s centre, or None when none
+        is needed: the part needs a fence along the other axis too, no fence for that axis
+        (on the table, or among ``routes``) stands in front of the part now, and one would if
+        the part were moved along ``axis`` to the nearest coordinate it covers (with ``COVER``
+        of the part to spare, and the levelling push's own end spread, the free push's along
+        ``axis``, inside that). A corner is built from there: the part pressed against that
+        fence and slid along it onto the fence of this axis."""
+        other = 1 - axis
+        if not self.needed(part, axis) or not self.needed(part, other):
+            return None
+        target = self.problem.goal.target(part)
+        if (
+            abs(interval.center[other] - target[other]) + interval.half[other]
+            <= (self.problem.goal.tolerance[other])
+        ):
+            return None  # within its goal along the other axis: no fence needed there now
+        sign = 1 if target[other] > interval.center[other] else -1
+        boxes = [
+            self.checker.shadow_box(place.obj, place.pose, _ZERO)
+            for place in routes.get((part, other, sign), ())
+        ]
+        goal_face = self.goal_face(part, other, sign)
+        tolerance = self.problem.goal.tolerance[other]
+        for spec in self.problem.fixtures:
+            fixture = belief.get(spec.name)
+            if fixture is not None:
+                box = self.checker.shadow_box(spec.name, fixture.center, _ZERO)
+                if abs((box[other] if sign > 0 else box[other + 2]) - goal_face) <= tolerance:
+                    boxes.append(box)
+        goal_box = self.goal_boxes[part]
+        spare = COVER * (goal_box[axis + 2] - goal_box[axis])
+        centre = interval.center[axis]
+        if any(b[axis] + spare <= centre + 1e-9 <= b[axis + 2] - spare + 2e-9 for b in boxes):
+            return None  # level with a fence already
+        inset = spare + self.needs[(part, axis)]
+        best = None
+        for box in boxes:
+            low, high = box[axis] + inset, box[axis + 2] - inset
+            if low <= high:
+                at = _clamp(centre, low, high)
+                if best is None or abs(at - centre) < abs(best - centre):
+                    best = at
+        return best
+
     def needed(self, part: str, axis: int) -> bool:
         return (part, axis) in self.needs
 
     def goal_face(self, part: str, axis: int, sign: int) -> float:
-        """The coordinate of ``part``'s goal footprint's face on the ``sign`` side along
-        ``axis``."""
-        box = self.goal_boxes[part]
+        """Where a fence holding ``part`` pushed along ``axis`` towards ``sign`` stands: the
+        goal footprint's face on that side of the last part of its goal train (the part
+        itself when no goal part touches it ahead; :meth:`train`)."""
+        end = self.train(part, axis, sign)[-1:] or (part,)
+        box = self.goal_boxes[end[0]]
         return box[axis + 2] if sign > 0 else box[axis]
+
+    def train(self, part: str, axis: int, sign: int) -> tuple[str, ...]:
+        """The goal parts ahead of ``part`` along ``axis`` towards ``sign`` that touch in a row
+        in the goal arrangement (within twice the tolerance): pushed, the part presses them
+        against the fence, as a wall train is pressed against its wall."""
+        key = (part, axis, sign)
+        if key not in self._trains:
+            slack = 2.0 * max(self.problem.goal.tolerance[:2]) + 1e-6
+            other = 1 - axis
+            box, train = self.goal_boxes[part], [part]
+            while True:
+                front = box[axis + 2] if sign > 0 else -box[axis]
+                ahead = [
+                    q
+                    for q, b in self.goal_boxes.items()
+                    if q not in train
+                    and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
+                    and abs((b[axis] if sign > 0 else -b[axis + 2]) - front) <= slack
+                ]
+                if not ahead:
+                    break
+                train.append(ahead[0])
+                box = self.goal_boxes[ahead[0]]
+            self._trains[key] = tuple(train[1:])
+        return self._trains[key]
 
     # -- where fences go -----------------------------------------------------------------------
     def placements(
@@ -157,11 +264,7 @@ class Fences:
                 abs(interval.center[axis] - target[axis]) + interval.half[axis] <= tolerance
             ):
                 continue  # already within its goal along the axis
-            # Across the push: centred on the goal's coordinate and on the part's present one
-            # (its swath), each moved as little as keeps the fence on the table.
-            across = [target[other]]
-            if interval is not None and abs(interval.center[other] - target[other]) > 1e-6:
-                across.append(interval.center[other])
+            present = interval.center[other] if interval is not None else target[other]
             width = self.goal_boxes[part][other + 2] - self.goal_boxes[part][other]
             for sign in (1, -1):
                 if (
@@ -177,28 +280,46 @@ class Fences:
                         shadow = self.checker.shadow_box(fixture, (0.0, 0.0, theta), self.place_unc)
                         along = face - (box[axis] if sign > 0 else box[axis + 2])
                         size = self.problem.table.size[other]
-                        for centre in dict.fromkeys(across):
-                            low = max(centre + COVER * width - box[other + 2], GAP - shadow[other])
-                            high = min(
-                                centre - COVER * width - box[other],
-                                size - GAP - shadow[other + 2],
+                        # Across: covering the goal's coordinate (where the part must be held
+                        # at the end), with COVER of the part to spare either side.
+                        low = max(
+                            target[other] + COVER * width - box[other + 2], GAP - shadow[other]
+                        )
+                        high = min(
+                            target[other] - COVER * width - box[other],
+                            size - GAP - shadow[other + 2],
+                        )
+                        if low > high:
+                            continue
+                        # centred on the goal, and nearest the part's present coordinate (a part
+                        # it covers there too is pressed against it now and slides along it
+                        # to its goal); only where neither can stand, at either end of the
+                        # range (clear of another fence there: two fences make a corner). An
+                        # end is offered last because a part that drifts across the push
+                        # leaves a fence it covers by no more than COVER.
+                        centred = (_clamp(target[other], low, high), _clamp(present, low, high))
+                        found = self._standing(fixture, axis, along, theta, centred, on_table)
+                        if not found:
+                            found = self._standing(
+                                fixture, axis, along, theta, (low, high), on_table
                             )
-                            if low > high:
-                                continue
-                            # nearest the centre first, then either end of the range (clear
-                            # of another fence there, say)
-                            for at in dict.fromkeys((min(max(centre, low), high), low, high)):
-                                pose = (along, at, theta) if axis == 0 else (at, along, theta)
-                                pose = (_round(pose[0]), _round(pose[1]), theta)
-                                if self.checker.shadow_inside_table(
-                                    fixture, pose, self.place_unc
-                                ) and self.checker.shadow_clear(
-                                    fixture, pose, self.place_unc, on_table
-                                ):
-                                    places.append(Place(fixture, pose))
+                        places += found
                 if places:
                     routes[(part, axis, sign)] = places
         return routes
+
+    def _standing(self, fixture, axis, along, theta, across, on_table) -> list[Place]:
+        """The places of ``fixture`` at ``along`` and each of ``across`` (once each) that meet
+        the place precondition."""
+        places = []
+        for at in dict.fromkeys(across):
+            pose = (along, at, theta) if axis == 0 else (at, along, theta)
+            pose = (_round(pose[0]), _round(pose[1]), theta)
+            if self.checker.shadow_inside_table(
+                fixture, pose, self.place_unc
+            ) and self.checker.shadow_clear(fixture, pose, self.place_unc, on_table):
+                places.append(Place(fixture, pose))
+        return places
 
     # -- using a fence -------------------------------------------------------------------------
     def face_ahead(
@@ -213,6 +334,68 @@ class Fences:
         shadow = self.checker.shadow_box(part, interval.center, interval.half)
         front = shadow[axis + 2] if sign > 0 else -shadow[axis]
         return found[1] if sign * found[1] >= front - 1e-9 else None
+
+    def clear_paths(
+        self,
+        part: str,
+        belief: IntervalBelief,
+        axis: int,
+        sign: int,
+        centres: Sequence[float],
+        span: tuple[float, float],
+        approach: tuple[float, float],
+        manipulator: tuple[float, float],
+        travel: float,
+    ) -> list[float]:
+        """The manipulator's centres across a push of ``part`` moved, where needed, so that its
+        path misses the fixtures on the table (a fence for the other axis, say): the approach
+        shadow is checked at the start only, and a manipulator that runs into a fence stalls
+        there.
+
+        ``centres`` are the generator's, ``span`` the range a centre may take (the part's
+        centre covered, the walls cleared), ``approach`` the approach shadow's extent along the
+        push and ``manipulator`` its extent across, both relative to the commanded centre
+        across; ``travel`` the longest distance pushed. The path runs from the approach to
+        where the manipulator stops, a part's depth short of its set point (the part is between).
+        A centre whose path meets a fixture is replaced by the nearest one in ``span`` that
+        misses them all (dropped if none does)."""
+        interval = belief.get(part)
+        if interval is None:
+            return list(centres)
+        other = 1 - axis
+        nominal = self.checker.shadow_box(part, interval.center, _ZERO)
+        depth = nominal[axis + 2] - nominal[axis]
+        reach = max(travel - depth, 0.0)
+        low, high = (
+            (approach[0], approach[1] + reach) if sign > 0 else (approach[0] - reach, approach[1])
+        )
+        forbidden = []
+        for spec in self.problem.fixtures:
+            fixture = belief.get(spec.name)
+            if fixture is None:
+                continue
+            box = self.checker.shadow_box(spec.name, fixture.center, fixture.half)
+            if box[axis + 2] > low and box[axis] < high:
+                forbidden.append(
+                    (box[other] - manipulator[1] - GAP, box[other + 2] - manipulator[0] + GAP)
+                )
+        if not forbidden:
+            return list(centres)
+
+        def clear(value: float) -> bool:
+            return all(not (lo < value < hi) for lo, hi in forbidden)
+
+        edges = [v for bounds in forbidden for v in bounds if span[0] <= v <= span[1]]
+        result: list[float] = []
+        for centre in centres:
+            if not clear(centre):
+                options = sorted((v for v in edges if clear(v)), key=lambda v: abs(v - centre))
+                if not options:
+                    continue
+                centre = options[0]
+            if all(abs(centre - r) > 1e-6 for r in result):
+                result.append(centre)
+        return result
 
     def holding(self, belief: IntervalBelief, inside) -> set[str]:
         """The fixtures on the table that hold a goal part at its goal along an axis that needs
@@ -236,8 +419,10 @@ class Fences:
         """A fixture on the table (and its near face) whose near face, seen from ``part``
         pushed along ``axis`` towards ``sign``, lies within the tolerance of the part's goal
         face, and whose footprint covers the part's centre across the push."""
-        if part not in self.goal_boxes:
-            return None
+        if part not in self.goal_boxes or any(
+            q not in belief for q in self.train(part, axis, sign)
+        ):
+            return None  # its train (if any) must be on the table to be pressed against it
         goal_face = self.goal_face(part, axis, sign)
         tolerance = self.problem.goal.tolerance[axis]
         other = 1 - axis

@@ -256,9 +256,8 @@ def _goal_conditions(problem: ArrangementProblem, fl: PoseFluents, em: Any) -> l
         for fluent, target, tol in bounds:
             out.append(em.GE(fluent, em.Real(target - tol)))
             out.append(em.LE(fluent, em.Real(target + tol)))
-    for spec in problem.fixtures:
-        if problem.initial_of(spec.name) is None:
-            out.append(em.Not(fl.on_table[spec.name]))
+    for name in problem.put_away:
+        out.append(em.Not(fl.on_table[name]))
     return out
 
 

@@ -182,6 +182,38 @@ def test_load_refuses_a_goal_without_both_bounds_and_a_missing_pose():
     assert "block is on the table but has no (x block)" in messages
 
 
+def test_the_goal_states_that_a_fixture_off_the_table_must_end_off_it():
+    # down-push's bar starts off the table: the format's rule (it must end off it) is stated
+    text = write_pddl_problem(load("down-push"))
+    assert "(not (on-table bar))" in text.split("(:goal")[1]
+    up = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / "down-push.pddl"))
+    assert "(not on-table(bar))" in str(up.goals)
+    assert load_pddl_problem(domains_dir() / "down-push.pddl").put_away == ("bar",)
+    # a file without it (written before the rule was stated) reads as before: the rule holds
+    old = text.replace("(not (on-table bar))", "")
+    assert problem_hash(load_pddl_problem_text(old, "dp.pddl")) == problem_hash(load("down-push"))
+    # a fixture that starts on the table may stay: the goal is refused, not tightened
+    on = text.replace(
+        "(on-table block) (= (x block) 6)",
+        "(on-table bar) (= (x bar) 1) (= (y bar) 1)\n    (on-table block) (= (x block) 6)",
+    )
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(on, "dp.pddl")
+    (error,) = caught.value.errors
+    assert "bar is a fixture that starts on the table (it may stay)" in error.message
+    assert error.line == on.splitlines().index("    (not (on-table bar))") + 1
+
+
+def test_the_goal_refuses_what_contradicts_the_put_away_rule():
+    text = write_pddl_problem(load("down-push"))
+    part = text.replace("(not (on-table bar))", "(not (on-table block))")
+    with pytest.raises(ProblemFormatError, match=r"block is a part; a goal can require off"):
+        load_pddl_problem_text(part, "dp.pddl")
+    kept = text.replace("(not (on-table bar))", "(on-table bar)")
+    with pytest.raises(ProblemFormatError, match=r"\(on-table bar\): bar is a fixture that starts"):
+        load_pddl_problem_text(kept, "dp.pddl")
+
+
 def test_load_refuses_another_domain_and_a_missing_file(tmp_path: Path):
     text = (
         (domains_dir() / "blocks-1.pddl")

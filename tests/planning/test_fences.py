@@ -51,9 +51,9 @@ def test_fence_places_stand_at_the_goal_face_and_replace_the_open_pushes_along_t
     belief = IntervalBelief((("A", ObjectInterval((2.0, 0.5, 0.0), (0.1, 0.05, 0.05))),))
     candidates = gen.candidates(belief)
     fences = [a for a in candidates if isinstance(a, Place)]
-    # the bar's left face on A's goal face (x = 6.5), standing: as low as the bottom wall
-    # allows, then as high as it still covers A's centre with a quarter of A to spare
-    assert fences == [Place("bar", (6.65, 1.304473, 0.0)), Place("bar", (6.65, 1.5, 0.0))]
+    # the bar's left face on A's goal face (x = 6.5), standing, centred on A's goal y as far
+    # as the bottom wall allows (A is at its goal y already: no second place)
+    assert fences == [Place("bar", (6.65, 1.304473, 0.0))]
     rightwards = [a for a in candidates if isinstance(a, Push) and abs(a.pose[2] + 1.5708) < 1e-3]
     assert rightwards == []  # no push ending in the open along x while a fence can stand
     fenced = IntervalBelief(
@@ -64,6 +64,115 @@ def test_fence_places_stand_at_the_goal_face_and_replace_the_open_pushes_along_t
     paddle_front = pushes[0].pose[0] + 0.075
     assert paddle_front + pushes[0].distance == pytest.approx(6.5, abs=1e-3)
     assert Pick("bar") in gen.candidates(fenced)
+
+
+def test_a_fence_covers_the_goal_across_and_the_part_where_it_can_do_both(corner):
+    gen = _generator(corner)
+    high = IntervalBelief((("A", ObjectInterval((2.0, 2.0, 0.0), (0.1, 0.1, 0.05))),))
+    fences = [a for a in gen.candidates(high) if isinstance(a, Place)]
+    # centred on A's goal y (as far as the wall allows), then nearest A's y (2.0): as high as
+    # it still covers A's goal y with a quarter of A to spare (it covers A at y 2.0 too)
+    assert fences == [Place("bar", (6.65, 1.304473, 0.0)), Place("bar", (6.65, 1.5, 0.0))]
+    # a bar centred on A's present y would not hold A at its goal: none is offered
+    higher = IntervalBelief((("A", ObjectInterval((2.0, 3.5, 0.0), (0.1, 0.1, 0.05))),))
+    poses = [a.pose for a in gen.candidates(higher) if isinstance(a, Place)]
+    assert poses == [(6.65, 1.304473, 0.0), (6.65, 1.5, 0.0)]
+
+
+@pytest.fixture(scope="module")
+def open_corner():
+    return load_problem(FRESH / "fence-open-corner.yaml")
+
+
+def test_a_bar_placed_turned_keeps_one_interval_of_angles_and_serves_as_a_fence(open_corner):
+    # a bar looks the same turned by 180 degrees; placed at 90 degrees, its particles once
+    # wrapped to either end of [-90, 90) and the belief said "any angle", which made the
+    # bar seen at 0 degrees, no fence for the push down onto it
+    semantics = make_semantics("particles", open_corner, particles=10, seed=0)
+    try:
+        belief = semantics.initial_belief()
+        for action in (Place("bar2", (6.0, 2.35, math.pi / 2)), Place("bar1", (6.65, 4.0, 0.0))):
+            belief = semantics.apply(belief, action)
+        bar = belief.intervals.get("bar2")
+        assert bar.center[2] == pytest.approx(math.pi / 2, abs=0.01)
+        assert bar.half[2] < math.radians(2.5)  # the place noise, +-2 degrees
+        block = ("A", ObjectInterval((6.0, 5.0, 0.0), (0.05, 0.3, 0.05)))
+        intervals = IntervalBelief((block, *belief.intervals.objects[1:]))
+        assert _generator(open_corner).fences.face_ahead(
+            "A", block[1], intervals, 1, -1
+        ) == pytest.approx(2.5, abs=0.05)  # its top face, within its place noise
+    finally:
+        semantics.close()
+
+
+def test_a_push_onto_one_fence_keeps_the_paddle_clear_of_the_other(open_corner):
+    # A pressed against bar1 (x face 6.5, y 2.75..5.25) is pushed down onto bar2: a 2.5 in
+    # paddle centred on A (x 6) would run into bar1's top end and stall there
+    gen = _generator(open_corner)
+    belief = IntervalBelief(
+        (
+            ("A", ObjectInterval((6.0, 5.0, 0.0), (0.05, 0.3, 0.05))),
+            ("bar1", ObjectInterval((6.65, 4.0, 0.0), (0.03, 0.03, 0.035))),
+            ("bar2", ObjectInterval((6.0, 2.35, math.pi / 2), (0.03, 0.03, 0.035))),
+        )
+    )
+    (down,) = [p for p in gen.pushes(belief) if abs(abs(p.pose[2]) - math.pi) < 1e-3]
+    paddle_right = down.pose[0] + 1.25 + open_corner.uncertainty.push[0]
+    assert paddle_right < 6.5 - 0.03  # clear of bar1's left face and its place noise
+    assert down.pose[0] + 1.25 - 0.1 >= 6.0  # and still covering A's centre
+    assert down.pose[1] - 0.075 - down.distance == pytest.approx(2.5, abs=1e-3)  # to bar2
+
+
+def test_the_planner_builds_a_corner_whose_fences_hold_the_block_at_its_goal(open_corner):
+    result = arrange_up.plan(open_corner, particles=20, workers=1)
+    assert result.solved, result.reason
+    goal_x, goal_y, _ = open_corner.goal.target("A")
+    fences = [a for a in result.actions if isinstance(a, Place)]
+    assert {a.obj for a in fences} == {"bar1", "bar2"}
+    for fence in fences:
+        # each bar covers A's goal coordinate across the push that presses A against it,
+        # with a quarter of A to spare (a bar at A's start, y 5, was left on the way)
+        x, y, theta = fence.pose
+        across, goal = (x, goal_x) if abs(math.sin(theta)) > 0.5 else (y, goal_y)
+        assert abs(across - goal) <= 1.25 - 0.25 + 1e-6
+    assert set(result.actions[-2:]) == {Pick("bar1"), Pick("bar2")}
+
+
+def test_a_part_no_fence_can_stand_in_front_of_yet_is_first_brought_level_with_one():
+    # fence-middle-corner: A (1.2 x 0.8 in) from (9, 2.5) to (5, 6); both axes need a fence.
+    # A 3 in bar at A's goal face x 4.4 must cover A's goal y (6) with a quarter of A to
+    # spare, so it stands at y 4.7 at the lowest and covers y 3.2..6.2: A at y 2.5 is in
+    # front of no such bar, and pushes along x would leave any fence of y behind.
+    problem = load_problem(FRESH / "fence-middle-corner.yaml")
+    gen = _generator(problem)
+    start = ("A", ObjectInterval((9.0, 2.5, 0.0), (0.25, 0.25, 0.09)))
+    belief = IntervalBelief((start,))
+    routes = gen.fence_routes(belief)
+    # up to where that bar covers A, with A's own free push end spread (0.15 in) inside it
+    level = gen.fences.level("A", start[1], belief, 1, routes)
+    assert level == pytest.approx(3.2 + 0.2 + 0.12 + 0.0322 * 0.96, abs=1e-3)
+    ups = [p for p in gen.pushes(belief) if abs(p.pose[2]) < 1e-3]
+    assert len(ups) == 1  # the levelling push: no other push that ends in the open along y
+    # once level, no levelling push: the fences' own pushes take over
+    there = ("A", ObjectInterval((9.0, level, 0.0), (0.25, 0.15, 0.09)))
+    assert gen.fences.level("A", there[1], IntervalBelief((there,)), 1, routes) is None
+
+
+def test_a_row_is_pressed_against_one_fence_at_its_last_part():
+    # fence-row: A (goal x 5.5) touches B (6.5) ahead of it; a fence at A's own goal face
+    # (x 6) would stand on B's goal, so A's fence is B's, at x 7, through the row
+    problem = load_problem(FRESH / "fence-row.yaml")
+    gen = _generator(problem)
+    assert set(gen.fences.needs) == {("A", 0), ("B", 0)}  # the bottom wall holds y
+    assert gen.fences.train("A", 0, 1) == ("B",)
+    assert gen.fences.goal_face("A", 0, 1) == pytest.approx(7.0)
+    low = ("A", ObjectInterval((3.0, 0.55, 0.0), (0.1, 0.05, 0.05)))
+    bar = ("bar", ObjectInterval((7.15, 1.304473, 0.0), (0.03, 0.03, 0.035)))
+    # pressed against the bar only once B, the row's last part, is on the table
+    assert gen.fences.face_ahead("A", low[1], IntervalBelief((low, bar)), 0, 1) is None
+    high = ("B", ObjectInterval((2.0, 4.5, 0.0), (0.1, 0.1, 0.05)))
+    belief = IntervalBelief((low, high, bar))
+    assert gen.fences.face_ahead("A", low[1], belief, 0, 1) == pytest.approx(7.0)
 
 
 def test_a_fixture_put_down_must_be_picked_up_before_the_goal_is_reached(corner):
