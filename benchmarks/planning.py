@@ -5,7 +5,10 @@ Usage::
     python benchmarks/planning.py [--cases blocks-7:25,blocks-4:50] [--configs local:1,local:2]
         [--baseline GITREF] [--repeats 3] [--seed 0] [--output planning-bench.csv]
 
-A case is ``PROBLEM:PARTICLES`` (0 particles: the deterministic planner); a config is
+A case is ``PROBLEM:PARTICLES`` (0 particles: the deterministic planner) or ``PROBLEM:cbst``
+(CBST's interval beliefs); ``PROBLEM`` is a shipped name or a problem file, optionally followed
+by ``@CONTROLLER`` to plan it under that controller (``blocks-9@servo:cbst``: blocks-9 under
+the servo, the controller whose CBST model plans it). A config is
 ``local:WORKERS`` or ``dask:WORKERS`` (a LocalCluster of that many processes). Every run is
 its own Python process (so peak memory is that run's and no pool or cache carries over), with
 ``PYTHONPATH`` at this checkout, or, for ``--baseline GITREF``, at a copy of that commit made
@@ -60,20 +63,35 @@ FIELDS = [
 ]
 
 
-def child(problem_name: str, particles: int, seed: int, config: str) -> None:
+def parse_case(case: str) -> tuple[str, str]:
+    """``(problem, particles)`` of a case (see the module doc); ``particles`` is a count or
+    ``cbst``."""
+    problem, _, particles = case.rpartition(":")
+    if not problem or not (particles == "cbst" or particles.isdigit()):
+        raise SystemExit(f"--cases: {case!r} is not PROBLEM:PARTICLES or PROBLEM:cbst")
+    return problem, particles
+
+
+def child(problem_name: str, particles: str, seed: int, config: str) -> None:
     """One planning run in this process (the code on ``PYTHONPATH``); prints a JSON row."""
     import arrange_up
+    from arrange_up.model.problem import driven_by
     from arrange_up.planning.planner import plan
 
     backend, workers = config.split(":")
     options: dict = {"workers": int(workers)}
     if backend != "local":
         options["backend"] = backend
-    if particles == 0:
+    if particles == "cbst":
+        options.update(semantics="cbst")
+    elif int(particles) == 0:
         options.update(semantics="deterministic", particles=1, workers=1)
     else:
-        options.update(particles=particles)
-    problem = arrange_up.load(problem_name)
+        options.update(particles=int(particles))
+    name, _, controller = problem_name.partition("@")
+    problem = arrange_up.load(name)
+    if controller:
+        problem = driven_by(problem, controller)
     startup = 0.0
     if backend != "local":
         # the cluster is started (and cached) first: "seconds" is the planning on it, as
@@ -119,7 +137,7 @@ def checkout(ref: str, into: Path) -> Path:
     return tree
 
 
-def run(code_root: Path, case: tuple[str, int], config: str, seed: int) -> dict:
+def run(code_root: Path, case: tuple[str, str], config: str, seed: int) -> dict:
     env = {**os.environ, "PYTHONPATH": str(code_root)}
     command = [sys.executable, str(Path(__file__).resolve()), "--child"]
     command += [f"{case[0]}:{case[1]}", config, str(seed)]
@@ -140,11 +158,11 @@ def main() -> None:
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        name, particles = args.child[0].rsplit(":", 1)
-        child(name, int(particles), int(args.child[2]), args.child[1])
+        name, particles = parse_case(args.child[0])
+        child(name, particles, int(args.child[2]), args.child[1])
         return
 
-    cases = [(c.rsplit(":", 1)[0], int(c.rsplit(":", 1)[1])) for c in args.cases.split(",")]
+    cases = [parse_case(c) for c in args.cases.split(",")]
     configs = args.configs.split(",")
     with tempfile.TemporaryDirectory() as scratch:
         codes = {"new": ROOT}
