@@ -75,6 +75,8 @@ FIXTURE_REFUSAL = "a pushed object may slip past the end of a fixture ahead"
 #: Distinct feature rows whose prediction a semantics remembers (about 100 bytes each); past
 #: it the memory starts again empty.
 PREDICTION_CACHE = 200_000
+#: Contact-graph nodes (an object's belief in a push's frame) a semantics remembers.
+NODE_CACHE = 100_000
 #: Shapes and sizes are compared with this tolerance (inches).
 _SIZE_TOL = 1e-6
 
@@ -115,6 +117,7 @@ class CBSTSemantics:
         self.workers = workers
         self.simulations = 0
         self._predictions: dict[tuple[float, ...], np.ndarray | None] = {}
+        self._nodes: dict[tuple[str, str, ObjectInterval], Node] = {}
         self.reasons: Counter[str] = Counter()
         self.model = model_for(problem, model)
         card = self.model.card_
@@ -194,20 +197,7 @@ class CBSTSemantics:
         if frame is None:
             return self._refuse("the push is not axis-aligned")
         d = self.block_size
-        nodes = []
-        for name, iv in belief.objects:
-            center = frame.pose_to(iv.center)
-            # The model was trained on square blocks with centre angle 0 (mod 90 degrees).
-            aligned = abs(wrap_angle(center[2], 0.0, 0.5 * math.pi)) <= 1e-6
-            nodes.append(
-                Node(
-                    name,
-                    center,
-                    frame.half_to(iv.half),
-                    frame.box_to(self.checker.shadow_box(name, iv.center, iv.half)),
-                    block=self._block.get(name, False) and aligned,
-                )
-            )
+        nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
         push_unc = problem.uncertainty.push
         xmin, ymin, xmax, ymax = spec.shape.extent
         along_y = abs(py) > abs(px)  # the push direction in the manipulator's own frame
@@ -312,6 +302,28 @@ class CBSTSemantics:
             )
             objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
         return self._belief(objects)
+
+    def _node(self, frame: CanonicalFrame, name: str, interval: ObjectInterval) -> Node:
+        """The contact graph's node of ``name`` at ``interval`` in ``frame``; remembered (up to
+        :data:`NODE_CACHE` of them), since the same objects' beliefs recur in many beliefs."""
+        key = (frame.direction, name, interval)
+        node = self._nodes.get(key)
+        if node is None:
+            center = frame.pose_to(interval.center)
+            # The model was trained on square blocks with centre angle 0 (mod 90 degrees).
+            aligned = abs(wrap_angle(center[2], 0.0, 0.5 * math.pi)) <= 1e-6
+            box = self.checker.shadow_box(name, interval.center, interval.half)
+            node = Node(
+                name,
+                center,
+                frame.half_to(interval.half),
+                frame.box_to(box),
+                block=self._block.get(name, False) and aligned,
+            )
+            if len(self._nodes) >= NODE_CACHE:
+                self._nodes.clear()
+            self._nodes[key] = node
+        return node
 
     def _predict(self, rows: list[list[float]]) -> np.ndarray | None:
         """The model's ``(dx, dy, dth, slip)`` (clipped at 0) per feature row, or None when a
