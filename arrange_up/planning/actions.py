@@ -316,6 +316,7 @@ class ActionGenerator:
             for spec in self.problem.parts
             if spec.name in self.problem.goal.parts
         )
+        boxes = [(name, self.checker.shadow_box(name, c, h)) for name, c, h in on_table]
         actions: list[Push] = []
         for manip in self.manipulators:
             if manip.spec.name in belief:
@@ -327,14 +328,24 @@ class ActionGenerator:
                 for direction in self.directions:
                     actions.extend(
                         self._pushes_of(
-                            manip, spec.name, interval, direction, belief, on_table, ladder, routes
+                            manip,
+                            spec.name,
+                            interval,
+                            direction,
+                            belief,
+                            on_table,
+                            boxes,
+                            ladder,
+                            routes,
                         )
                     )
         return actions
 
     def _pushes_of(
-        self, manip, name, interval, direction, belief, on_table, ladder=False, routes=None
+        self, manip, name, interval, direction, belief, on_table, boxes, ladder=False, routes=None
     ) -> list[Push]:
+        """The pushes of part ``name`` along ``direction``; ``on_table`` are the belief's
+        shadows ``(name, centre, half)`` and ``boxes`` their ``(name, shadow box)``."""
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
         sign = int(ux + uy)  # +1 or -1
@@ -356,7 +367,7 @@ class ActionGenerator:
             name, interval, belief, axis, sign, front_nominal, ladder, routes or {}
         )
         pushes = []
-        for across in self._across(manip, name, interval, axis, sign, along, m_box, on_table):
+        for across in self._across(manip, name, interval, axis, sign, along, m_box, boxes):
             pose = (along, across, theta) if axis == 0 else (across, along, theta)
             if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
                 for d, travel in distances:
@@ -367,7 +378,7 @@ class ActionGenerator:
                     pushes.append(push)
         return pushes
 
-    def _across(self, manip, name, interval, axis, sign, along, m_box, on_table) -> list[float]:
+    def _across(self, manip, name, interval, axis, sign, along, m_box, boxes) -> list[float]:
         """Where to centre the manipulator across the push (at most two centres).
 
         The first is as near the part's centre as the walls and the shadows beside the approach
@@ -386,11 +397,7 @@ class ActionGenerator:
         if low > high:
             return []
         a_lo, a_hi = along + m_box[axis], along + m_box[axis + 2]
-        boxes = [
-            self.checker.shadow_box(other_name, pose, half)
-            for other_name, pose, half in on_table
-            if other_name != name
-        ]
+        boxes = [box for other_name, box in boxes if other_name != name]
         # Shadows (and obstacles) level with the approach forbid the centres that would make
         # them overlap: each gives the open interval of such centres.
         forbidden = [

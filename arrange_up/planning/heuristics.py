@@ -51,6 +51,10 @@ HEURISTICS = ("inadmissible", "admissible", "ordering", "manhattan", "blind")
 
 Heuristic = Callable[[ParticleBelief], float]
 
+#: Answers "does this part's belief block that place candidate for good" the ordering filter
+#: remembers.
+BLOCKING_CACHE = 200_000
+
 
 def make_heuristic(
     name: str,
@@ -172,6 +176,7 @@ class _OrderingFilter:
         self.pairs: list[tuple[str, str, int]] = []  # (a, b, axis): goal has a before b on axis
         self._place_cache: dict[str, list] = {}
         self._goal_overlaps: dict[tuple[str, int, str], bool] = {}
+        self._blocking: dict[tuple, bool] = {}
         self._pairs_blocking = None
         if goal.reference is not None:
             return
@@ -215,17 +220,26 @@ class _OrderingFilter:
         ``q``'s current shadow and ``q``'s goal footprint: the planner only ever moves ``q``
         towards its goal, and between two overlapping positions ``q`` keeps overlapping.
         """
-        half = self.generator.place_unc
         found = []
         for k, pose in enumerate(self._candidates(part, intervals)):
-            candidate = (part, pose, half)
-            if not any(
-                self._meets_goal(part, k, pose, q)
-                and self.checker.shadows_overlap(candidate, (q, iv.center, iv.half))
-                for q, iv in placed
-            ):
+            if not any(self._blocks(part, k, pose, q, iv) for q, iv in placed):
                 found.append(k)
         return found
+
+    def _blocks(self, part: str, k: int, pose, q: str, interval) -> bool:
+        """Whether ``q`` at ``interval`` blocks ``part``'s place candidate ``k`` (at ``pose``)
+        for good (:meth:`_open_candidates`); remembered, since the same parts' beliefs recur
+        in many beliefs (up to :data:`BLOCKING_CACHE` answers)."""
+        key = (part, k, q, interval)
+        blocks = self._blocking.get(key)
+        if blocks is None:
+            blocks = self._meets_goal(part, k, pose, q) and self.checker.shadows_overlap(
+                (part, pose, self.generator.place_unc), (q, interval.center, interval.half)
+            )
+            if len(self._blocking) >= BLOCKING_CACHE:
+                self._blocking.clear()
+            self._blocking[key] = blocks
+        return blocks
 
     def _meets_goal(self, part: str, k: int, pose, q: str) -> bool:
         """Whether ``part``'s place candidate ``k`` (at ``pose``) overlaps ``q``'s goal
