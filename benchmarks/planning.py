@@ -17,11 +17,13 @@ only: its ``plan`` knows no backend, so dask configs are not run for it). Old an
 case alternate, repeat by repeat and in alternating order, so a pair shares the machine's load.
 
 Each run prints one row: wall seconds of the ``plan`` call (for dask, after the LocalCluster
-was started, which ``startup_s`` gives), nodes expanded, transitions
+was started, which ``startup_s`` gives) and the CPU seconds of this process in it (``cpu_s``:
+under load from other processes the steadier measure of a serial run), nodes expanded, transitions
 evaluated, simulations (``transitions_simulated``), simulations per second, the process's peak
 resident memory (MB; worker processes not included) and the plan length; and whether its plan
 equals the first run's of the case (``same``). The summary gives, per case and config, the
-median seconds and the ratio old / new of the medians (paired in the sense above). Rows are
+median wall and CPU seconds and the ratios old / new of the medians (paired in the sense
+above). Rows are
 appended to ``--output`` as they are measured.
 """
 
@@ -51,6 +53,7 @@ FIELDS = [
     "repeat",
     "status",
     "seconds",
+    "cpu_s",
     "startup_s",
     "expanded",
     "evaluated",
@@ -101,9 +104,9 @@ def child(problem_name: str, particles: str, seed: int, config: str) -> None:
         begin = time.perf_counter()
         get_runner(backend, int(workers))
         startup = time.perf_counter() - begin
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     result = plan(problem, seed=seed, **options)
-    seconds = time.perf_counter() - start
+    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     stats = result.stats
     actions = repr(result.actions).encode()
     print(
@@ -111,6 +114,7 @@ def child(problem_name: str, particles: str, seed: int, config: str) -> None:
             {
                 "status": str(result.status),
                 "seconds": round(seconds, 3),
+                "cpu_s": round(cpu, 3),
                 "startup_s": round(startup, 3),
                 "expanded": stats["expanded"],
                 "evaluated": stats["evaluated"],
@@ -170,6 +174,7 @@ def main() -> None:
             codes = {"old": checkout(args.baseline, Path(scratch)), "new": ROOT}
         new_file = not args.output.exists()
         times: dict[tuple, list[float]] = {}
+        cpus: dict[tuple, list[float]] = {}
         with args.output.open("a", newline="") as handle:
             writer = csv.DictWriter(handle, FIELDS)
             if new_file:
@@ -194,6 +199,7 @@ def main() -> None:
                                 same=row["plan_hash"] == first_hash,
                             )
                             times.setdefault((case, config, code), []).append(row["seconds"])
+                            cpus.setdefault((case, config, code), []).append(row["cpu_s"])
                             writer.writerow(row)
                             handle.flush()
                             shown = (f for f in FIELDS if f != "plan_hash")
@@ -204,10 +210,14 @@ def main() -> None:
             new = times.get((case, config, "new"))
             old = times.get((case, config, "old"))
             line = f"{case[0]}:{case[1]} {config}: new {statistics.median(new):.2f} s"
+            new_cpu = statistics.median(cpus[(case, config, "new")])
+            line += f" (CPU {new_cpu:.2f} s)"
             if old:
                 old_median = statistics.median(old)
+                old_cpu = statistics.median(cpus[(case, config, "old")])
                 line += (
-                    f", old {old_median:.2f} s, old/new {old_median / statistics.median(new):.2f}x"
+                    f", old {old_median:.2f} s (CPU {old_cpu:.2f} s), old/new "
+                    f"{old_median / statistics.median(new):.2f}x (CPU {old_cpu / new_cpu:.2f}x)"
                 )
             print(line)
     if args.baseline:
