@@ -51,8 +51,8 @@ HEURISTICS = ("inadmissible", "admissible", "ordering", "manhattan", "blind")
 
 Heuristic = Callable[[ParticleBelief], float]
 
-#: Answers "does this part's belief block that place candidate for good" the ordering filter
-#: remembers.
+#: Answers "which place candidates of that part does this part's belief block for good" the
+#: ordering filter remembers.
 BLOCKING_CACHE = 200_000
 
 
@@ -176,7 +176,7 @@ class _OrderingFilter:
         self.pairs: list[tuple[str, str, int]] = []  # (a, b, axis): goal has a before b on axis
         self._place_cache: dict[str, list] = {}
         self._goal_overlaps: dict[tuple[str, int, str], bool] = {}
-        self._blocking: dict[tuple, bool] = {}
+        self._blocking: dict[tuple, frozenset[int]] = {}
         self._pairs_blocking = None
         if goal.reference is not None:
             return
@@ -220,26 +220,32 @@ class _OrderingFilter:
         ``q``'s current shadow and ``q``'s goal footprint: the planner only ever moves ``q``
         towards its goal, and between two overlapping positions ``q`` keeps overlapping.
         """
-        found = []
-        for k, pose in enumerate(self._candidates(part, intervals)):
-            if not any(self._blocks(part, k, pose, q, iv) for q, iv in placed):
-                found.append(k)
-        return found
+        poses = self._candidates(part, intervals)
+        blocked: set[int] = set()
+        for q, interval in placed:
+            blocked |= self._blocked_by(part, poses, q, interval)
+        return [k for k in range(len(poses)) if k not in blocked]
 
-    def _blocks(self, part: str, k: int, pose, q: str, interval) -> bool:
-        """Whether ``q`` at ``interval`` blocks ``part``'s place candidate ``k`` (at ``pose``)
-        for good (:meth:`_open_candidates`); remembered, since the same parts' beliefs recur
-        in many beliefs (up to :data:`BLOCKING_CACHE` answers)."""
-        key = (part, k, q, interval)
-        blocks = self._blocking.get(key)
-        if blocks is None:
-            blocks = self._meets_goal(part, k, pose, q) and self.checker.shadows_overlap(
-                (part, pose, self.generator.place_unc), (q, interval.center, interval.half)
+    def _blocked_by(self, part: str, poses, q: str, interval) -> frozenset[int]:
+        """The indices of ``part``'s place candidates (``poses``, fixed for an absolute goal)
+        that ``q`` at ``interval`` blocks for good (:meth:`_open_candidates`); remembered,
+        since the same parts' beliefs recur in many beliefs (up to :data:`BLOCKING_CACHE`)."""
+        key = (part, q, interval)
+        blocked = self._blocking.get(key)
+        if blocked is None:
+            half = self.generator.place_unc
+            blocked = frozenset(
+                k
+                for k, pose in enumerate(poses)
+                if self._meets_goal(part, k, pose, q)
+                and self.checker.shadows_overlap(
+                    (part, pose, half), (q, interval.center, interval.half)
+                )
             )
             if len(self._blocking) >= BLOCKING_CACHE:
                 self._blocking.clear()
-            self._blocking[key] = blocks
-        return blocks
+            self._blocking[key] = blocked
+        return blocked
 
     def _meets_goal(self, part: str, k: int, pose, q: str) -> bool:
         """Whether ``part``'s place candidate ``k`` (at ``pose``) overlaps ``q``'s goal
