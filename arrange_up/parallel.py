@@ -93,6 +93,7 @@ __all__ = [
     "SerialRunner",
     "Session",
     "available_cores",
+    "check_runner_options",
     "get_runner",
     "local_executor",
     "shutdown",
@@ -563,16 +564,13 @@ _RUNNERS: dict[tuple[Any, ...], Runner] = {}
 _LOCK = threading.Lock()
 
 
-def get_runner(
+def check_runner_options(
     backend: str = "local", workers: int | None = None, scheduler: str | None = None
-) -> Runner:
-    """The runner of a backend, cached per process (pools and clusters live across batches).
-
-    ``workers=None`` means every core this process may use (:func:`available_cores`); for
-    ``"dask"`` with a ``scheduler`` address the cluster's own workers are used and ``workers``
-    is ignored. Raises ``ValueError`` for an unknown backend or a bad worker count,
-    :class:`BackendUnavailableError` when dask is missing or the scheduler cannot be reached.
-    """
+) -> None:
+    """Raise ``ValueError`` for an unknown backend, a worker count that is not a positive
+    integer, or a scheduler address without the dask backend; start nothing. A caller that
+    may not need a runner checks its options with this first, so that bad options fail alike
+    whether a runner is made or not."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
     if workers is not None and (
@@ -581,6 +579,19 @@ def get_runner(
         raise ValueError(f"workers must be a positive integer, got {workers!r}")
     if scheduler is not None and backend != "dask":
         raise ValueError("a scheduler address needs the dask backend")
+
+
+def get_runner(
+    backend: str = "local", workers: int | None = None, scheduler: str | None = None
+) -> Runner:
+    """The runner of a backend, cached per process (pools and clusters live across batches).
+
+    ``workers=None`` means every core this process may use (:func:`available_cores`); for
+    ``"dask"`` with a ``scheduler`` address the cluster's own workers are used and ``workers``
+    is ignored. Raises ``ValueError`` for the options :func:`check_runner_options` refuses,
+    :class:`BackendUnavailableError` when dask is missing or the scheduler cannot be reached.
+    """
+    check_runner_options(backend, workers, scheduler)
     if backend == "local":
         n = workers or available_cores()
         return SerialRunner() if n == 1 else LocalRunner(n)

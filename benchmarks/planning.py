@@ -5,7 +5,10 @@ Usage::
     python benchmarks/planning.py [--cases blocks-7:25,blocks-4:50] [--configs local:1,local:2]
         [--baseline GITREF] [--repeats 3] [--seed 0] [--output planning-bench.csv]
 
-A case is ``PROBLEM:PARTICLES`` (0 particles: the deterministic planner); a config is
+A case is ``PROBLEM:PARTICLES`` (0 particles: the deterministic planner) or ``PROBLEM:cbst``
+(CBST's interval beliefs); ``PROBLEM`` is a shipped name or a problem file, optionally followed
+by ``@CONTROLLER`` to plan it under that controller (``blocks-9@servo:cbst``: blocks-9 under
+the servo, the controller whose CBST model plans it). A config is
 ``local:WORKERS`` or ``dask:WORKERS`` (a LocalCluster of that many processes). Every run is
 its own Python process (so peak memory is that run's and no pool or cache carries over), with
 ``PYTHONPATH`` at this checkout, or, for ``--baseline GITREF``, at a copy of that commit made
@@ -14,11 +17,13 @@ only: its ``plan`` knows no backend, so dask configs are not run for it). Old an
 case alternate, repeat by repeat and in alternating order, so a pair shares the machine's load.
 
 Each run prints one row: wall seconds of the ``plan`` call (for dask, after the LocalCluster
-was started, which ``startup_s`` gives), nodes expanded, transitions
+was started, which ``startup_s`` gives) and the CPU seconds of this process in it (``cpu_s``:
+under load from other processes the steadier measure of a serial run), nodes expanded, transitions
 evaluated, simulations (``transitions_simulated``), simulations per second, the process's peak
 resident memory (MB; worker processes not included) and the plan length; and whether its plan
 equals the first run's of the case (``same``). The summary gives, per case and config, the
-median seconds and the ratio old / new of the medians (paired in the sense above). Rows are
+median wall and CPU seconds and the ratios old / new of the medians (paired in the sense
+above). Rows are
 appended to ``--output`` as they are measured.
 """
 
@@ -48,6 +53,7 @@ FIELDS = [
     "repeat",
     "status",
     "seconds",
+    "cpu_s",
     "startup_s",
     "expanded",
     "evaluated",
@@ -60,20 +66,35 @@ FIELDS = [
 ]
 
 
-def child(problem_name: str, particles: int, seed: int, config: str) -> None:
+def parse_case(case: str) -> tuple[str, str]:
+    """``(problem, particles)`` of a case (see the module doc); ``particles`` is a count or
+    ``cbst``."""
+    problem, _, particles = case.rpartition(":")
+    if not problem or not (particles == "cbst" or particles.isdigit()):
+        raise SystemExit(f"--cases: {case!r} is not PROBLEM:PARTICLES or PROBLEM:cbst")
+    return problem, particles
+
+
+def child(problem_name: str, particles: str, seed: int, config: str) -> None:
     """One planning run in this process (the code on ``PYTHONPATH``); prints a JSON row."""
     import arrange_up
+    from arrange_up.model.problem import driven_by
     from arrange_up.planning.planner import plan
 
     backend, workers = config.split(":")
     options: dict = {"workers": int(workers)}
     if backend != "local":
         options["backend"] = backend
-    if particles == 0:
+    if particles == "cbst":
+        options.update(semantics="cbst")
+    elif int(particles) == 0:
         options.update(semantics="deterministic", particles=1, workers=1)
     else:
-        options.update(particles=particles)
-    problem = arrange_up.load(problem_name)
+        options.update(particles=int(particles))
+    name, _, controller = problem_name.partition("@")
+    problem = arrange_up.load(name)
+    if controller:
+        problem = driven_by(problem, controller)
     startup = 0.0
     if backend != "local":
         # the cluster is started (and cached) first: "seconds" is the planning on it, as
@@ -83,9 +104,9 @@ def child(problem_name: str, particles: int, seed: int, config: str) -> None:
         begin = time.perf_counter()
         get_runner(backend, int(workers))
         startup = time.perf_counter() - begin
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     result = plan(problem, seed=seed, **options)
-    seconds = time.perf_counter() - start
+    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     stats = result.stats
     actions = repr(result.actions).encode()
     print(
@@ -93,6 +114,7 @@ def child(problem_name: str, particles: int, seed: int, config: str) -> None:
             {
                 "status": str(result.status),
                 "seconds": round(seconds, 3),
+                "cpu_s": round(cpu, 3),
                 "startup_s": round(startup, 3),
                 "expanded": stats["expanded"],
                 "evaluated": stats["evaluated"],
@@ -119,7 +141,7 @@ def checkout(ref: str, into: Path) -> Path:
     return tree
 
 
-def run(code_root: Path, case: tuple[str, int], config: str, seed: int) -> dict:
+def run(code_root: Path, case: tuple[str, str], config: str, seed: int) -> dict:
     env = {**os.environ, "PYTHONPATH": str(code_root)}
     command = [sys.executable, str(Path(__file__).resolve()), "--child"]
     command += [f"{case[0]}:{case[1]}", config, str(seed)]
@@ -140,11 +162,11 @@ def main() -> None:
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        name, particles = args.child[0].rsplit(":", 1)
-        child(name, int(particles), int(args.child[2]), args.child[1])
+        name, particles = parse_case(args.child[0])
+        child(name, particles, int(args.child[2]), args.child[1])
         return
 
-    cases = [(c.rsplit(":", 1)[0], int(c.rsplit(":", 1)[1])) for c in args.cases.split(",")]
+    cases = [parse_case(c) for c in args.cases.split(",")]
     configs = args.configs.split(",")
     with tempfile.TemporaryDirectory() as scratch:
         codes = {"new": ROOT}
@@ -152,6 +174,7 @@ def main() -> None:
             codes = {"old": checkout(args.baseline, Path(scratch)), "new": ROOT}
         new_file = not args.output.exists()
         times: dict[tuple, list[float]] = {}
+        cpus: dict[tuple, list[float]] = {}
         with args.output.open("a", newline="") as handle:
             writer = csv.DictWriter(handle, FIELDS)
             if new_file:
@@ -176,6 +199,7 @@ def main() -> None:
                                 same=row["plan_hash"] == first_hash,
                             )
                             times.setdefault((case, config, code), []).append(row["seconds"])
+                            cpus.setdefault((case, config, code), []).append(row["cpu_s"])
                             writer.writerow(row)
                             handle.flush()
                             shown = (f for f in FIELDS if f != "plan_hash")
@@ -186,10 +210,14 @@ def main() -> None:
             new = times.get((case, config, "new"))
             old = times.get((case, config, "old"))
             line = f"{case[0]}:{case[1]} {config}: new {statistics.median(new):.2f} s"
+            new_cpu = statistics.median(cpus[(case, config, "new")])
+            line += f" (CPU {new_cpu:.2f} s)"
             if old:
                 old_median = statistics.median(old)
+                old_cpu = statistics.median(cpus[(case, config, "old")])
                 line += (
-                    f", old {old_median:.2f} s, old/new {old_median / statistics.median(new):.2f}x"
+                    f", old {old_median:.2f} s (CPU {old_cpu:.2f} s), old/new "
+                    f"{old_median / statistics.median(new):.2f}x (CPU {old_cpu / new_cpu:.2f}x)"
                 )
             print(line)
     if args.baseline:

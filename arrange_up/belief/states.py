@@ -145,17 +145,24 @@ class IntervalBelief:
 
     objects: tuple[tuple[str, ObjectInterval], ...]
 
-    def names(self) -> tuple[str, ...]:
+    # The names and the lookup table are made once per belief: the action generator, the
+    # heuristics and the dominance index ask for them many times per belief.
+    @cached_property
+    def _names(self) -> tuple[str, ...]:
         return tuple(name for name, _ in self.objects)
 
+    @cached_property
+    def _by_name(self) -> dict[str, ObjectInterval]:
+        return dict(reversed(self.objects))  # an object listed twice: its first interval
+
+    def names(self) -> tuple[str, ...]:
+        return self._names
+
     def get(self, name: str) -> ObjectInterval | None:
-        for other, interval in self.objects:
-            if other == name:
-                return interval
-        return None
+        return self._by_name.get(name)
 
     def __contains__(self, name: object) -> bool:
-        return any(other == name for other, _ in self.objects)
+        return name in self._by_name
 
     # The planner's view of a belief (shared with ParticleBelief): ``poses`` holds the box's
     # low and high corners as two pseudo-particles. Goal tests, heuristics and dominance only

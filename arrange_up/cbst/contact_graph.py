@@ -7,7 +7,7 @@ implementation for the four axis directions.
 
 The graph
 =========
-A :class:`networkx.DiGraph` with the node :data:`ROBOT` (the paddle), the node :data:`WALL` and
+A :class:`ContactGraph` with the node :data:`ROBOT` (the paddle), the node :data:`WALL` and
 one node per object the push may move. MAKECG: starting from the robot, each node's belief
 bounding box (its shadow box) is swept toward ``+u`` up to the wall; every object whose box
 overlaps the swept volume and that may lie *in front of* it gets an edge; every node gets an
@@ -61,8 +61,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-import networkx as nx
-
 from arrange_up.geometry.shapes import Box, HalfWidths, Pose, boxes_overlap
 
 __all__ = [
@@ -73,6 +71,7 @@ __all__ = [
     "REACH_MARGIN",
     "ROBOT",
     "WALL",
+    "ContactGraph",
     "Member",
     "Node",
     "Paddle",
@@ -194,7 +193,7 @@ class PushStructure:
 
     kind: str
     reason: str = ""
-    graph: nx.DiGraph | None = None
+    graph: ContactGraph | None = None
     paths: tuple[tuple[object, ...], ...] = ()
     members: tuple[Member, ...] = ()
     length: int = 0
@@ -209,19 +208,58 @@ class Unpredictable(Exception):
     """Raised inside the analysis; turned into ``PushStructure(kind="none", reason=...)``."""
 
 
+class ContactGraph:
+    """A directed graph whose every edge ``a -> b`` carries whether the contact is certain.
+
+    Nodes are kept in the order they were first met, and each node's successors and
+    predecessors in the order their edges were added, so every walk over the graph is
+    deterministic. (A plain pair of dicts: building a general graph library's digraph took
+    a third of a CBST push's analysis.)
+    """
+
+    __slots__ = ("_ahead", "_behind")
+
+    def __init__(self) -> None:
+        self._ahead: dict[object, dict[object, bool]] = {}
+        self._behind: dict[object, dict[object, bool]] = {}
+
+    def add_node(self, node: object) -> None:
+        self._ahead.setdefault(node, {})
+        self._behind.setdefault(node, {})
+
+    @property
+    def nodes(self) -> list[object]:
+        return list(self._ahead)
+
+    def __contains__(self, node: object) -> bool:
+        return node in self._ahead
+
+    def has_edge(self, a: object, b: object) -> bool:
+        return b in self._ahead.get(a, ())
+
+    def certain(self, a: object, b: object) -> bool:
+        """Whether the contact ``a -> b`` is certain (``KeyError`` if there is no edge)."""
+        return self._ahead[a][b]
+
+    def successors(self, node: object) -> tuple[object, ...]:
+        return tuple(self._ahead[node])
+
+    def predecessors(self, node: object) -> tuple[object, ...]:
+        return tuple(self._behind[node])
+
+
 # -- pair relations ------------------------------------------------------------------------------
 def _swept(box: Box, end: float) -> Box:
     umin, vmin, umax, vmax = box
     return (umin, vmin, max(umax, end), vmax)
 
 
-def _contact(a: Node | Paddle, b: Node, block_size: float, end: float) -> bool | None:
-    """The edge ``a -> b``: None (no contact), False (possible) or True (certain).
+def _contact(a: Node | Paddle, b: Node, block_size: float) -> bool | None:
+    """The edge ``a -> b`` of a ``b`` whose box overlaps ``a``'s box swept up to the wall:
+    None (no contact), False (possible) or True (certain).
 
     Raises :class:`Unpredictable` when the order of the two along the push is undecided.
     """
-    if not boxes_overlap(b.box, _swept(a.box, end)):
-        return None
     d = block_size
     dv = abs(b.center[1] - a.center[1])
     if isinstance(a, Paddle):
@@ -256,7 +294,7 @@ def make_contact_graph(
     wall: float | None,
     block_size: float,
     obstacles: Sequence[Box] = (),
-) -> nx.DiGraph:
+) -> ContactGraph:
     """MAKECG (Figure 3-4) in the canonical frame.
 
     Returns the graph of the nodes reachable from :data:`ROBOT`; edges carry ``certain``.
@@ -264,41 +302,59 @@ def make_contact_graph(
     or a reached object that is not a block.
     """
     end = wall if wall is not None else math.inf
-    graph = nx.DiGraph()
+    graph = ContactGraph()
     graph.add_node(ROBOT)
+    if wall is not None:
+        graph.add_node(WALL)
+    # the graph's own tables, filled here directly: this is the hot loop of a CBST search
+    ahead, behind = graph._ahead, graph._behind
     agenda: list[Node | Paddle] = [paddle]
     seen: set[str] = set()
     while agenda:
         current = agenda.pop()
         source = ROBOT if isinstance(current, Paddle) else current.name
+        swept = _swept(current.box, end)
         for box in obstacles:
-            if boxes_overlap(box, _swept(current.box, end)):
+            if boxes_overlap(box, swept):
                 raise Unpredictable("an obstacle lies in the path of the push")
+        u0, v0, u1, v1 = swept
         for other in nodes:
-            if not isinstance(current, Paddle) and other.name == current.name:
+            if other.name == source:
                 continue
-            certain = _contact(current, other, block_size, end)
+            # boxes_overlap(other.box, swept), written out: this loop is a CBST search's
+            # hottest
+            box = other.box
+            if not (
+                min(box[2], u1) - max(box[0], u0) > 0.0 and min(box[3], v1) - max(box[1], v0) > 0.0
+            ):
+                continue
+            certain = _contact(current, other, block_size)
             if certain is None:
                 continue
             if not other.block:
                 raise Unpredictable(f"{other.name!r} may be pushed and is not a block")
-            graph.add_edge(source, other.name, certain=certain)
-            if other.name not in seen:
-                seen.add(other.name)
+            name = other.name
+            if name not in seen:
+                seen.add(name)
                 agenda.append(other)
+                ahead[name], behind[name] = {}, {}
+            ahead[source][name] = certain
+            behind[name][source] = certain
         if wall is not None:
-            graph.add_edge(source, WALL, certain=True)
+            ahead[source][WALL] = True
+            behind[WALL][source] = True
     return graph
 
 
-def maximal_paths(graph: nx.DiGraph) -> list[tuple[object, ...]]:
+def maximal_paths(graph: ContactGraph) -> list[tuple[object, ...]]:
     """The ``ROBOT -> WALL`` paths not contained in another one, longest first (ties in a
     fixed order). Raises :class:`Unpredictable` beyond :data:`MAX_PATHS` paths."""
     if WALL not in graph:
         return []
     # A path contained in another is strictly shorter, so each is tested against the longer
     # paths kept so far only.
-    paths = sorted(set(_paths_to_wall(graph)), key=lambda p: (-len(p), [repr(n) for n in p]))
+    label = {node: repr(node) for node in graph.nodes}
+    paths = sorted(set(_paths_to_wall(graph)), key=lambda p: (-len(p), [label[n] for n in p]))
     kept: list[tuple[object, ...]] = []
     kept_sets: list[frozenset[object]] = []
     for path in paths:
@@ -309,25 +365,52 @@ def maximal_paths(graph: nx.DiGraph) -> list[tuple[object, ...]]:
     return kept
 
 
-def _paths_to_wall(graph: nx.DiGraph) -> list[tuple[object, ...]]:
-    """Every ``ROBOT -> WALL`` path of the contact graph, by a depth-first walk over its
-    adjacency. Every edge points forward along the push (an object's contacts are only with
-    what lies ahead of it), so the graph is acyclic and every path is simple; the generic
-    simple-path enumeration of networkx spent most of a CBST push's analysis on the
-    bookkeeping that this needs not."""
-    successors = {node: tuple(adjacent) for node, adjacent in graph.adj.items()}
+def _paths_to_wall(graph: ContactGraph) -> list[tuple[object, ...]]:
+    """The ``ROBOT -> WALL`` paths of the contact graph that may be maximal: those whose last
+    object touches nothing but the wall, by a depth-first walk over its adjacency.
+
+    Every edge points forward along the push (an object's contacts are only with what lies
+    ahead of it), so the graph is acyclic and every path is simple. Every node has an edge to
+    the wall, so every path from the robot is a path to the wall; one that ends at an object
+    with an object ahead is contained in its own extension, hence never maximal, and is only
+    counted (for :data:`MAX_PATHS`, which counts every path), not kept. (The generic
+    simple-path enumeration of networkx spent most of a CBST push's analysis on bookkeeping
+    that this needs not.)"""
+    successors = {node: graph.successors(node) for node in graph.nodes}
     paths: list[tuple[object, ...]] = []
+    found = 0
     stack: list[tuple[object, ...]] = [(ROBOT,)]
     while stack:
         path = stack.pop()
-        for nxt in successors[path[-1]]:
+        ahead = successors[path[-1]]
+        for nxt in ahead:
             if nxt is WALL:
-                paths.append((*path, WALL))
-                if len(paths) > MAX_PATHS:
+                found += 1
+                if found > MAX_PATHS:
                     raise Unpredictable("too many contact paths to analyse")
+                if len(ahead) == 1:
+                    paths.append((*path, WALL))
             elif nxt not in path:
                 stack.append((*path, nxt))
     return paths
+
+
+def _longest_train(graph: ContactGraph) -> int:
+    """The number of objects on the longest ``ROBOT -> WALL`` path (the graph is acyclic: each
+    node's longest train ahead is worked out once, deepest first)."""
+    ahead: dict[object, int] = {}
+    stack: list[tuple[object, bool]] = [(ROBOT, False)]
+    while stack:
+        node, done = stack.pop()
+        if node in ahead:
+            continue
+        objects = [n for n in graph.successors(node) if n is not WALL]
+        if done:
+            ahead[node] = max((1 + ahead[n] for n in objects), default=0)
+            continue
+        stack.append((node, True))
+        stack.extend((n, False) for n in objects if n not in ahead)
+    return ahead[ROBOT]
 
 
 # -- PUSHTRANS (structure) -----------------------------------------------------------------------
@@ -355,8 +438,14 @@ def _analyse(paddle, nodes, wall, block_size, obstacles) -> PushStructure:
     reached = [n for n in graph.nodes if n is not ROBOT and n is not WALL]
     if wall is None:
         raise Unpredictable("no wall ahead: the pushed objects are not stopped")
+    # The reach test needs only the longest train, found without listing the paths: most
+    # pushes a search refuses fail it, and listing the paths is the costly part.
+    length = _longest_train(graph)
+    front = paddle.center[0] + 0.5 * paddle.thickness + paddle.travel - paddle.half[0]
+    if front < wall - length * block_size + PUSH_MARGIN:
+        raise Unpredictable("the push stops short of compressing the train against the wall")
     paths = maximal_paths(graph)
-    length = len(paths[0]) - 2
+    assert len(paths[0]) - 2 == length
     depth: dict[str, int] = {}
     on_long: set[str] = set()
     for path in paths:
@@ -381,22 +470,19 @@ def _analyse(paddle, nodes, wall, block_size, obstacles) -> PushStructure:
             raise Unpredictable(
                 f"the paddle may reach {objects[0]!r}, whose train is shorter than the longest"
             )
-    front = paddle.center[0] + 0.5 * paddle.thickness + paddle.travel - paddle.half[0]
-    if front < wall - length * d + PUSH_MARGIN:
-        raise Unpredictable("the push stops short of compressing the train against the wall")
     members = []
     for name in sorted(on_long, key=lambda n: (-depth[n], n)):
         k = depth[name]
         prevs = tuple(
             p
             for p in graph.predecessors(name)
-            if graph.edges[p, name]["certain"]
+            if graph.certain(p, name)
             and ((p is ROBOT and k == length) or (p is not ROBOT and depth.get(p) == k + 1))
         )
         nexts = tuple(
             q
             for q in graph.successors(name)
-            if graph.edges[name, q]["certain"]
+            if graph.certain(name, q)
             and ((q is WALL and k == 1) or (q is not WALL and depth.get(q) == k - 1))
         )
         if not nexts:

@@ -146,7 +146,8 @@ def plan(
 
     The workers simulate the pushes the search will evaluate next while it deals with the
     current one; the plan does not depend on --workers or --backend (equal seeds give equal
-    plans). --workers defaults to all cores (1 for the deterministic semantics).
+    plans). --workers defaults to all cores (1 for the deterministic semantics). The cbst
+    semantics predicts in this process: it starts no workers or cluster.
 
     Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted: the
     candidates ran out, unsolvable: proven, e.g. a goal part larger than the table), 2 bad

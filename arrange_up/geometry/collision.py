@@ -48,6 +48,10 @@ class CollisionChecker:
         self._wall_geoms = {edge: _box_geom(box) for edge, box in self.walls.items()}
         self._shadow_box = lru_cache(maxsize=200_000)(self._shadow_box_uncached)
         self._shadow_hull = lru_cache(maxsize=20_000)(self._shadow_hull_uncached)
+        # a search tests the same shadows (and pairs of them) again and again, since the same
+        # objects' beliefs recur in many beliefs; the hulls' distances are the costly part
+        self._hulls_meet = lru_cache(maxsize=200_000)(self._hulls_meet_uncached)
+        self._hits_fixed = lru_cache(maxsize=100_000)(self._hits_fixed_uncached)
 
     # -- world states ------------------------------------------------------------------------
     def state_collides(self, state: WorldState) -> bool:
@@ -78,13 +82,24 @@ class CollisionChecker:
         self, a: tuple[str, Pose, HalfWidths], b: tuple[str, Pose, HalfWidths]
     ) -> bool:
         """True if the belief shadows of two objects may overlap (boxes, then hulls)."""
-        if not geometry.boxes_overlap(self.shadow_box(*a), self.shadow_box(*b), -CLEARANCE):
+        return self._overlap(self.shadow_box(*a), a[0], tuple(a[1]), tuple(a[2]), b)
+
+    def _overlap(self, box, name: str, pose: Pose, half: HalfWidths, other) -> bool:
+        """:meth:`shadows_overlap` of ``(name, pose, half)``, whose shadow box is ``box``
+        (tuples), and ``other``."""
+        if not geometry.boxes_overlap(box, self.shadow_box(*other), -CLEARANCE):
             return False
-        hull_a, hull_b = self.shadow_hull(*a), self.shadow_hull(*b)
+        return self._hulls_meet(name, pose, half, other[0], tuple(other[1]), tuple(other[2]))
+
+    def _hulls_meet_uncached(self, a, a_pose, a_half, b, b_pose, b_half) -> bool:
+        hull_a, hull_b = self.shadow_hull(a, a_pose, a_half), self.shadow_hull(b, b_pose, b_half)
         return hull_a.distance(hull_b) < CLEARANCE
 
     def shadow_hits_fixed(self, name: str, pose: Pose, half: HalfWidths) -> bool:
         """True if the object's shadow may touch a wall or an obstacle."""
+        return self._hits_fixed(name, tuple(pose), tuple(half))
+
+    def _hits_fixed_uncached(self, name: str, pose: Pose, half: HalfWidths) -> bool:
         box = self.shadow_box(name, pose, half)
         hull = None
         for edge, wall in self.walls.items():
@@ -113,10 +128,11 @@ class CollisionChecker:
         others: Iterable[tuple[str, Pose, HalfWidths]],
     ) -> bool:
         """The place precondition: ``name``'s shadow touches no other shadow, wall or obstacle."""
-        if self.shadow_hits_fixed(name, pose, half):
+        pose, half = tuple(pose), tuple(half)
+        if self._hits_fixed(name, pose, half):
             return False
-        candidate = (name, pose, half)
-        return not any(self.shadows_overlap(candidate, other) for other in others)
+        box = self._shadow_box(name, pose, half)
+        return not any(self._overlap(box, name, pose, half, other) for other in others)
 
 
 def _box_geom(box):

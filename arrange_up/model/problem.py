@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import functools
 import hashlib
 import json
 import math
@@ -144,15 +145,20 @@ class Goal:
     def is_relative(self) -> bool:
         return self.reference is not None
 
-    @property
+    @functools.cached_property
     def parts(self) -> tuple[str, ...]:
+        # cached: the planner's action generator and heuristics ask for it per candidate
         return tuple(name for name, _ in self.targets)
 
+    @functools.cached_property
+    def _target_of(self) -> dict[str, Pose]:
+        return dict(reversed(self.targets))  # a part listed twice: its first target
+
     def target(self, name: str) -> Pose:
-        for other, pose in self.targets:
-            if other == name:
-                return pose
-        raise KeyError(name)
+        try:
+            return self._target_of[name]
+        except KeyError:
+            raise KeyError(name) from None
 
 
 @dataclass(frozen=True)

@@ -344,6 +344,7 @@ class ActionGenerator:
             for spec in self.problem.parts
             if spec.name in self.problem.goal.parts
         )
+        boxes = [(name, self.checker.shadow_box(name, c, h)) for name, c, h in on_table]
         actions: list[Push] = []
         for manip in self.manipulators:
             if manip.spec.name in belief:
@@ -364,6 +365,7 @@ class ActionGenerator:
                         direction,
                         belief,
                         on_table,
+                        boxes,
                         ladder,
                         routes,
                         detours.get(direction),
@@ -429,13 +431,16 @@ class ActionGenerator:
         direction,
         belief,
         on_table,
+        boxes,
         ladder=False,
         routes=None,
         detour: float | None = None,
         jams: list[Push] | None = None,
     ) -> list[Push]:
-        """The pushes of ``name`` along ``direction``; those that would drive a state of the
-        part into an obstacle (:meth:`_cut_short`) are also appended to ``jams``."""
+        """The pushes of part ``name`` along ``direction``; ``on_table`` are the belief's
+        shadows ``(name, centre, half)`` and ``boxes`` their ``(name, shadow box)``. Those that
+        would drive a state of the part into an obstacle (:meth:`_cut_short`) are also appended
+        to ``jams``."""
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
         sign = int(ux + uy)  # +1 or -1
@@ -463,16 +468,16 @@ class ActionGenerator:
             # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
             # the shadow and APPROACH_GAP add across: only a noisy approach grazes them); else
             # where it was (it stops on one as the part reaches its end).
-            centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table, sweep)
+            centres = self._across(manip, name, interval, axis, sign, along, m_box, boxes, sweep)
             if sweep and not centres:
                 other = 1 - axis
                 margin = 0.5 * (m_box[other + 2] - m_box[other] - manip.length) + APPROACH_GAP
                 shrunk = tuple(_shrink(box, other, margin) for box in sweep)
                 centres = self._across(
-                    manip, name, interval, axis, sign, along, m_box, on_table, shrunk
+                    manip, name, interval, axis, sign, along, m_box, boxes, shrunk
                 )
             if sweep and not centres:
-                centres = self._across(manip, name, interval, axis, sign, along, m_box, on_table)
+                centres = self._across(manip, name, interval, axis, sign, along, m_box, boxes)
             if self.fences.needs and group:
                 centres = self._clear_of_fences(
                     manip, name, interval, belief, axis, sign, along, m_box, centres, group
@@ -532,7 +537,7 @@ class ActionGenerator:
         return list(groups.items())
 
     def _across(
-        self, manip, name, interval, axis, sign, along, m_box, on_table, sweep=()
+        self, manip, name, interval, axis, sign, along, m_box, boxes, sweep=()
     ) -> list[float]:
         """Where to centre the manipulator across the push (at most two centres).
 
@@ -553,11 +558,7 @@ class ActionGenerator:
         if low > high:
             return []
         a_lo, a_hi = along + m_box[axis], along + m_box[axis + 2]
-        boxes = [
-            self.checker.shadow_box(other_name, pose, half)
-            for other_name, pose, half in on_table
-            if other_name != name
-        ]
+        boxes = [box for other_name, box in boxes if other_name != name]
         # Shadows (and obstacles) level with the approach forbid the centres that would make
         # them overlap: each gives the open interval of such centres.
         forbidden = [

@@ -51,6 +51,10 @@ HEURISTICS = ("inadmissible", "admissible", "ordering", "manhattan", "blind")
 
 Heuristic = Callable[[ParticleBelief], float]
 
+#: Answers "which place candidates of that part does this part's belief block for good" the
+#: ordering filter remembers.
+BLOCKING_CACHE = 200_000
+
 
 def make_heuristic(
     name: str,
@@ -172,6 +176,7 @@ class _OrderingFilter:
         self.pairs: list[tuple[str, str, int]] = []  # (a, b, axis): goal has a before b on axis
         self._place_cache: dict[str, list] = {}
         self._goal_overlaps: dict[tuple[str, int, str], bool] = {}
+        self._blocking: dict[tuple, frozenset[int]] = {}
         self._pairs_blocking = None
         if goal.reference is not None:
             return
@@ -215,17 +220,32 @@ class _OrderingFilter:
         ``q``'s current shadow and ``q``'s goal footprint: the planner only ever moves ``q``
         towards its goal, and between two overlapping positions ``q`` keeps overlapping.
         """
-        half = self.generator.place_unc
-        found = []
-        for k, pose in enumerate(self._candidates(part, intervals)):
-            candidate = (part, pose, half)
-            if not any(
-                self._meets_goal(part, k, pose, q)
-                and self.checker.shadows_overlap(candidate, (q, iv.center, iv.half))
-                for q, iv in placed
-            ):
-                found.append(k)
-        return found
+        poses = self._candidates(part, intervals)
+        blocked: set[int] = set()
+        for q, interval in placed:
+            blocked |= self._blocked_by(part, poses, q, interval)
+        return [k for k in range(len(poses)) if k not in blocked]
+
+    def _blocked_by(self, part: str, poses, q: str, interval) -> frozenset[int]:
+        """The indices of ``part``'s place candidates (``poses``, fixed for an absolute goal)
+        that ``q`` at ``interval`` blocks for good (:meth:`_open_candidates`); remembered,
+        since the same parts' beliefs recur in many beliefs (up to :data:`BLOCKING_CACHE`)."""
+        key = (part, q, interval)
+        blocked = self._blocking.get(key)
+        if blocked is None:
+            half = self.generator.place_unc
+            blocked = frozenset(
+                k
+                for k, pose in enumerate(poses)
+                if self._meets_goal(part, k, pose, q)
+                and self.checker.shadows_overlap(
+                    (part, pose, half), (q, interval.center, interval.half)
+                )
+            )
+            if len(self._blocking) >= BLOCKING_CACHE:
+                self._blocking.clear()
+            self._blocking[key] = blocked
+        return blocked
 
     def _meets_goal(self, part: str, k: int, pose, q: str) -> bool:
         """Whether ``part``'s place candidate ``k`` (at ``pose``) overlaps ``q``'s goal

@@ -21,7 +21,7 @@ from arrange_up.belief.goals import PartMiss
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
-from arrange_up.parallel import SerialRunner, get_runner
+from arrange_up.parallel import Runner, SerialRunner, check_runner_options, get_runner
 from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
 from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_first_search
@@ -248,8 +248,11 @@ def plan(
         compute the successors the search will evaluate next while it deals with the current
         one (:mod:`arrange_up.planning.successors`); the plan and the statistics do not depend
         on where they run. A semantics that simulates no pushes (``cbst``) always computes
-        them in this process. Raises :class:`~arrange_up.parallel.BackendUnavailableError` when
-        dask is missing or the scheduler cannot be reached.
+        them in this process and starts no pool or cluster (nor reaches the scheduler). Bad
+        options raise ``ValueError`` before anything is built
+        (:func:`~arrange_up.parallel.check_runner_options`); for a semantics that simulates
+        pushes, :class:`~arrange_up.parallel.BackendUnavailableError` says that dask is
+        missing or the scheduler cannot be reached.
     tie_break
         Break ties among equally good nodes at random from ``seed`` (gives different but
         equally good plans for different seeds, e.g. for plan repair); default first-in
@@ -282,9 +285,8 @@ def plan(
     limit = (
         max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)
     )
-    # an unknown backend, a bad worker count or an unreachable scheduler fails before the
-    # task (and its worker processes) is built
-    runner = get_runner(backend, workers, scheduler)
+    # bad backend options fail before the task is built, whether a runner is made or not
+    check_runner_options(backend, workers, scheduler)
     task = BeliefTask.build(
         problem,
         semantics=semantics,
@@ -297,10 +299,16 @@ def plan(
         model=model,
         start=start,
     )
-    if not task.semantics.simulates_pushes:
-        # A learned prediction (CBST) costs less than shipping its job to a worker and back:
-        # workers only slowed such a search down, so it runs in this process (same plan).
-        runner = SerialRunner()
+    # A learned prediction (CBST) costs less than shipping its job to a worker and back:
+    # workers only slowed such a search down, so it runs in this process (same plan), and no
+    # pool or cluster is started (nor a scheduler reached) for it.
+    runner: Runner = SerialRunner()
+    if task.semantics.simulates_pushes:
+        try:
+            runner = get_runner(backend, workers, scheduler)
+        except BaseException:
+            task.close()
+            raise
     index = task.dominance_index()
     spec = WorkerSpec(problem, semantics, particles, seed, heuristic, model)
     evaluator = SuccessorEvaluator(task, runner, spec, index)

@@ -34,7 +34,9 @@ outcomes compare and hash equal and the search dedupes them.
   whose paddle sweep touches nothing returns the belief itself.
 
 The features of every object come from the belief *before* the push (as in the training
-data), so all of a push's predictions are one batched call of the fast forest.
+data), so all of a push's predictions are one batched call of the fast forest, made for the
+rows the semantics has not met before: a row's answer (its prediction, or that it lies outside
+the training domain) is remembered, since a search meets the same rows in many beliefs.
 
 A push returns ``None`` (no prediction) whenever the contact graph says so (see
 :mod:`arrange_up.cbst.contact_graph`), when the push is not axis-aligned, when the
@@ -70,6 +72,11 @@ __all__ = ["CBSTSemantics"]
 
 #: Why a push towards a fixture has no prediction when the fixture cannot stand in for a wall.
 FIXTURE_REFUSAL = "a pushed object may slip past the end of a fixture ahead"
+#: Distinct feature rows whose prediction a semantics remembers (about 100 bytes each); past
+#: it the memory starts again empty.
+PREDICTION_CACHE = 200_000
+#: Contact-graph nodes (an object's belief in a push's frame) a semantics remembers.
+NODE_CACHE = 100_000
 #: Shapes and sizes are compared with this tolerance (inches).
 _SIZE_TOL = 1e-6
 
@@ -109,6 +116,8 @@ class CBSTSemantics:
         self.seed = seed
         self.workers = workers
         self.simulations = 0
+        self._predictions: dict[tuple[float, ...], np.ndarray | None] = {}
+        self._nodes: dict[tuple[str, str, ObjectInterval], Node] = {}
         self.reasons: Counter[str] = Counter()
         self.model = model_for(problem, model)
         card = self.model.card_
@@ -188,20 +197,7 @@ class CBSTSemantics:
         if frame is None:
             return self._refuse("the push is not axis-aligned")
         d = self.block_size
-        nodes = []
-        for name, iv in belief.objects:
-            center = frame.pose_to(iv.center)
-            # The model was trained on square blocks with centre angle 0 (mod 90 degrees).
-            aligned = abs(wrap_angle(center[2], 0.0, 0.5 * math.pi)) <= 1e-6
-            nodes.append(
-                Node(
-                    name,
-                    center,
-                    frame.half_to(iv.half),
-                    frame.box_to(self.checker.shadow_box(name, iv.center, iv.half)),
-                    block=self._block.get(name, False) and aligned,
-                )
-            )
+        nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
         push_unc = problem.uncertainty.push
         xmin, ymin, xmax, ymax = spec.shape.extent
         along_y = abs(py) > abs(px)  # the push direction in the manipulator's own frame
@@ -263,10 +259,9 @@ class CBSTSemantics:
                         feature_row(p_half, p_v, p_obj, cur.half, cur.center[1], n_half, n_v)
                     )
                     owner.append(k)
-        X = np.asarray(rows, dtype=float).reshape(-1, 12)
-        if not bool(np.all(self.domain.contains(X))):
+        pred = self._predict(rows)
+        if pred is None:
             return self._refuse("a pushed object's belief is outside the model's training domain")
-        pred = np.maximum(self.model.predict_rows(X), 0.0) if len(X) else np.zeros((0, 4))
         self.simulations += len(rows)
         owner_arr = np.asarray(owner, dtype=int)
         low_wall, high_wall = frame.side_walls
@@ -307,6 +302,55 @@ class CBSTSemantics:
             )
             objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
         return self._belief(objects)
+
+    def _node(self, frame: CanonicalFrame, name: str, interval: ObjectInterval) -> Node:
+        """The contact graph's node of ``name`` at ``interval`` in ``frame``; remembered (up to
+        :data:`NODE_CACHE` of them), since the same objects' beliefs recur in many beliefs."""
+        key = (frame.direction, name, interval)
+        node = self._nodes.get(key)
+        if node is None:
+            center = frame.pose_to(interval.center)
+            # The model was trained on square blocks with centre angle 0 (mod 90 degrees).
+            aligned = abs(wrap_angle(center[2], 0.0, 0.5 * math.pi)) <= 1e-6
+            box = self.checker.shadow_box(name, interval.center, interval.half)
+            node = Node(
+                name,
+                center,
+                frame.half_to(interval.half),
+                frame.box_to(box),
+                block=self._block.get(name, False) and aligned,
+            )
+            if len(self._nodes) >= NODE_CACHE:
+                self._nodes.clear()
+            self._nodes[key] = node
+        return node
+
+    def _predict(self, rows: list[list[float]]) -> np.ndarray | None:
+        """The model's ``(dx, dy, dth, slip)`` (clipped at 0) per feature row, or None when a
+        row lies outside the training domain.
+
+        Each distinct row is judged and predicted once per search and then remembered
+        (:data:`PREDICTION_CACHE` rows): a search meets the same rows again and again, since
+        the same objects' beliefs recur in many beliefs. A row's prediction does not depend on
+        the rows predicted beside it, so the answers are those of a batch of all rows.
+        """
+        known = self._predictions
+        if len(known) > PREDICTION_CACHE:
+            known.clear()
+        keys = [tuple(row) for row in rows]
+        new = list(dict.fromkeys(key for key in keys if key not in known))
+        if new:
+            X = np.asarray(new, dtype=float).reshape(-1, 12)
+            inside = self.domain.contains(X)
+            pred = np.zeros((len(new), 4))
+            if inside.any():
+                pred[inside] = np.maximum(self.model.predict_rows(X[inside]), 0.0)
+            for key, ok, row in zip(new, inside, pred, strict=True):
+                known[key] = row if ok else None
+        found = [known[key] for key in keys]
+        if any(row is None for row in found):
+            return None
+        return np.asarray(found).reshape(-1, 4)
 
     def _fence_ahead(self, belief, frame, paddle, wall) -> tuple[str, float, float] | None:
         """The fixture on the table that stands in for the wall ahead (module docstring):

@@ -43,8 +43,9 @@ train-cbst`` made; default the shipped one for the problem's controller; it is l
 checked when the engine is made, and a problem whose controller is not the model's is
 refused), ``workers`` (1), ``backend`` (``"local"`` or ``"dask"``) and ``scheduler`` (a Dask
 scheduler address): where the search's successors are simulated, which does not change the
-plan (:mod:`arrange_up.planning.successors`); a scheduler that cannot be reached is an
-``INTERNAL_ERROR`` with a log message saying so.
+plan (:mod:`arrange_up.planning.successors`; ``cbst`` predicts in the planning process and
+starts no workers or cluster); a scheduler that cannot be reached is an ``INTERNAL_ERROR`` with
+a log message saying so.
 Metrics hold the search statistics (expanded, generated, evaluated, pruned, elapsed, ...).
 
 **The reliability validator** (:class:`ArrangeUpReliability`) judges a plan by Monte Carlo

@@ -66,7 +66,7 @@ def test_single_train_is_one_maximal_path_with_certain_contacts():
     nodes = [block("A", 9.45, 2.0), block("B", 8.0, 2.1)]
     graph = make_contact_graph(paddle(6.8, 2.0), nodes, wall=WALL_U, block_size=1.0)
     assert maximal_paths(graph) == [(ROBOT, "B", "A", WALL)]
-    assert graph.edges[ROBOT, "B"]["certain"] and graph.edges["B", "A"]["certain"]
+    assert graph.certain(ROBOT, "B") and graph.certain("B", "A")
     # Every node has an edge to the wall (thesis Figure 3-3).
     assert all(graph.has_edge(n, WALL) for n in (ROBOT, "A", "B"))
     s = analyse(paddle(6.8, 2.0), nodes)

@@ -17,6 +17,7 @@ from arrange_up.belief.states import ParticleBelief
 from arrange_up.model.problem import SERVO_CONTROLLER, driven_by
 from arrange_up.model.world import WorldState
 from arrange_up.parallel import get_runner
+from arrange_up.planning import planner as planner_module
 from arrange_up.planning import successors
 from arrange_up.planning.planner import plan
 
@@ -142,3 +143,28 @@ def test_cbst_plans_in_this_process_whatever_the_workers(monkeypatch):
     serial = plan(problem, semantics="cbst", workers=1)
     asked = plan(problem, semantics="cbst", workers=2)
     assert asked.status.value == "solved" and asked.actions == serial.actions
+
+
+def test_a_cbst_search_on_dask_makes_no_runner(monkeypatch):
+    # the runner is made after the task, only for a semantics that simulates pushes: a CBST
+    # search asked to run on Dask starts no LocalCluster (nor connects to a scheduler)
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("a CBST search made a Dask runner")
+
+    monkeypatch.setattr(parallel.DaskRunner, "__init__", refuse)
+    problem = driven_by(arrange_up.load("blocks-2"), "servo")
+    serial = plan(problem, semantics="cbst", workers=1)
+    on_dask = plan(problem, semantics="cbst", backend="dask", workers=2)
+    assert on_dask.solved and on_dask.actions == serial.actions
+
+
+def test_bad_backend_options_fail_before_the_task_is_built(monkeypatch):
+    def refuse(*args, **kwargs):
+        raise AssertionError("the task was built")
+
+    monkeypatch.setattr(planner_module.BeliefTask, "build", refuse)
+    problem = arrange_up.load("blocks-1")
+    with pytest.raises(ValueError, match="scheduler address needs the dask backend"):
+        plan(problem, semantics="cbst", backend="local", scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(ValueError, match="unknown backend"):
+        plan(problem, backend="ray")
