@@ -5,6 +5,7 @@ Usage::
 
     python benchmarks/cbst_wall_push.py [--examples 200] [--rollouts 100] [--seed 0]
         [--controller compliant] [--rules wall,uniform,planner]
+    python benchmarks/cbst_wall_push.py --tilt
 
 Every rule pushes the same examples (``arrange_up.cbst.data.generate_example``: the scenes,
 states, noise and paddle poses are the same for every rule; only the commanded distance
@@ -25,18 +26,37 @@ the examples with a buckled row, the examples not at rest, and per train length 
 and 90th percentile of the targets ``dx`` (in), ``dy`` (in), ``dθ`` (deg), and the share of
 rows whose outcome lies inside the model's training domain (``dx / 2`` and ``dy`` at most
 0.4 in, ``dθ`` at most 15°: a later push of that block can be predicted).
+
+``--tilt`` measures instead why a block pushed to the wall ends turned: one block at 0, 5, 10
+and 15°, the paddle centred on it or 0.5 in to either side, friction 0.25, 0.4 and 0.55
+(densities at the middle of their ranges), pushed by the ``planner`` rule (no pose
+uncertainty) and with its set point 1 in past the compressed block, under each controller.
+Printed: the largest and mean final ``|θ|`` of the block (in its 90° period) and the largest
+final ``|θ|`` of the paddle from its commanded angle (deg).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from dataclasses import replace
 
 import numpy as np
 
-from arrange_up.cbst.data import COMPLIANT, DEFAULT_GENERATION, SERVO, generate_example
+from arrange_up.cbst.data import (
+    COMPLIANT,
+    DEFAULT_GENERATION,
+    EAST,
+    SERVO,
+    _scene,
+    _wrap,
+    generate_example,
+)
 from arrange_up.cbst.features import BUCKLE_LIMIT
+from arrange_up.model.world import ActionNoise, Push, WorldState
+from arrange_up.physics.simulation import simulate
+from arrange_up.planning.stall import wall_overdrive
 
 
 def measure(rule: str, examples: int, rollouts: int, seed: int, controller) -> dict:
@@ -74,6 +94,40 @@ def measure(rule: str, examples: int, rollouts: int, seed: int, controller) -> d
     }
 
 
+def tilt() -> None:
+    """The ``--tilt`` measurement (module docstring)."""
+    for name, controller in (("compliant", COMPLIANT), ("servo", SERVO)):
+        settings = replace(DEFAULT_GENERATION, controller=controller)
+        problem = _scene(settings)
+        d = settings.block_size
+        wall = settings.table[0]
+        middle = 0.5 * settings.table[1]
+        planner = wall_overdrive(controller, settings.friction, settings.part_density, d * d, 0.0)
+        for label, over in (("planner", planner), ("1 in", 1.0)):
+            if over is None:
+                continue  # the servo's planner pushes go to the wall
+            for start_angle in (0, 5, 10, 15):
+                block, paddle = [], []
+                for friction in (0.25, 0.4, 0.55):
+                    for offset in (-0.5, 0.0, 0.5):
+                        state = WorldState(
+                            (("b0", (wall - 1.5 * d, middle, math.radians(start_angle))),)
+                        )
+                        start = wall - 2.8 * d
+                        front = wall - d + over
+                        push = Push("paddle", (start, middle + offset, EAST), front - start - 0.075)
+                        noise = ActionNoise((0.0, 0.0, 0.0), friction, 0.125, 0.4)
+                        outcome = simulate(problem, state, push, noise)
+                        theta = outcome.state.as_dict()["b0"][2]
+                        block.append(abs(math.degrees(_wrap(np.array(theta), 0.5 * math.pi))))
+                        paddle.append(abs(math.degrees(outcome.manipulator_pose[2] - EAST)))
+                print(
+                    f"{name:>9}, set point {label} past the block, start {start_angle:2d} deg: "
+                    f"block |theta| max {max(block):.2f} mean {np.mean(block):.2f} deg; "
+                    f"paddle |theta| max {max(paddle):.2f} deg"
+                )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--examples", type=int, default=200)
@@ -81,7 +135,11 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--controller", choices=("compliant", "servo"), default="compliant")
     parser.add_argument("--rules", default="wall,uniform,planner")
+    parser.add_argument("--tilt", action="store_true", help="the tilt measurement instead")
     args = parser.parse_args()
+    if args.tilt:
+        tilt()
+        return
     controller = COMPLIANT if args.controller == "compliant" else SERVO
     print(
         f"{args.examples} examples (seed {args.seed}) x {args.rollouts} rollouts, "
