@@ -17,8 +17,10 @@ resisting friction / Kp and stops short by as much. Under the servo it does not 
   the paddle's pose uncertainty along the push (its start, hence its set point, may lie that
   much behind), plus :data:`WALL_MARGIN`.
 
-The CBST training data (:mod:`arrange_up.cbst.data`) draws its pushes to the wall with the same
-:func:`wall_overdrive`, so that the model predicts the pushes the planner offers.
+With ``wall_push="planner"`` the CBST training data (:mod:`arrange_up.cbst.data`) draws its
+pushes to the wall with the same :func:`wall_overdrive`, so that the model predicts the pushes
+the planner offers (the planner gives CBST these pushes: ``compressed_wall_pushes`` in
+:mod:`arrange_up.planning.actions`; the particle semantics still push to the wall itself).
 """
 
 from __future__ import annotations
