@@ -63,6 +63,11 @@ of the pushed part and of the parts in a row ahead of it whose shadows it would 
 ``compressed_wall_pushes`` beyond the compressed train by more than its worst-case stall;
 :mod:`arrange_up.planning.stall`). Under the servo the stall is zero and the distances are as
 before.
+A push meant to move a part by a given travel then has its distance solved for in up to
+``SOLVER_STEPS`` noise-free simulations from the belief's centres, unless ``solve_distances``
+is off (the planner turns it off for semantics that do not simulate pushes, i.e. CBST: its
+model predicts only pushes that compress a train against a wall, and the simulations took
+half of a CBST search's time).
 
 A part is never pushed away from its own goal (beyond the goal tolerance along the direction):
 such a push cannot help it, and it multiplies the search's plateaus.
@@ -149,12 +154,14 @@ class ActionGenerator:
         unclipped_pushes: bool = False,
         settled_wall_pushes: bool = False,
         compressed_wall_pushes: bool = False,
+        solve_distances: bool = True,
     ) -> None:
         self.problem = problem
         self.checker = checker
         self.unclipped_pushes = unclipped_pushes
         self.settled_wall_pushes = settled_wall_pushes
         self.compressed_wall_pushes = compressed_wall_pushes
+        self.solve_distances = solve_distances
         hints = problem.planning
         self.directions = tuple(hints.push_directions or DIRECTIONS)
         self.push_distances = tuple(hints.push_distances or ())
@@ -371,7 +378,7 @@ class ActionGenerator:
             if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
                 for d, travel in distances:
                     push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
-                    if self.stall_per_area and travel is not None:
+                    if self.stall_per_area and self.solve_distances and travel is not None:
                         distance = self._solve_distance(push, name, axis, sign, travel, belief)
                         push = Push(push.manipulator, push.pose, distance)
                     pushes.append(push)

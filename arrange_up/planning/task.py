@@ -99,6 +99,7 @@ class BeliefTask:
                 unclipped_pushes=model.refuses_uncertain_contacts,
                 settled_wall_pushes=not model.simulates_pushes,
                 compressed_wall_pushes=not model.simulates_pushes,
+                solve_distances=model.simulates_pushes,
             )
             estimate = make_heuristic(heuristic, problem, goal, checker, generator)
         except BaseException:

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 import arrange_up
+import arrange_up.physics.simulation as physics
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
@@ -122,3 +123,31 @@ def test_cbst_pushes_to_a_wall_stop_just_past_the_compressed_train():
     assert any(abs(f - (wall - 2.0 + overdrive)) < 1e-3 for f in compressed)
     # The servo's pushes to the wall go to the wall either way.
     assert wall in fronts_of_b_right(servo, compressed_wall_pushes=True)
+
+
+def test_cbst_gets_the_stall_lengthened_distances_without_simulating_them(monkeypatch):
+    # A semantics that does not simulate pushes (CBST) only predicts pushes that compress a
+    # train against a wall, so solving a push's distance in simulations (the compliant
+    # controller's goal-coordinate pushes) is turned off for it: the distance is the free
+    # travel plus the nominal stall, and nothing is simulated.
+    compliant = arrange_up.load("blocks-2")
+    belief = IntervalBelief((("A", ObjectInterval((7.0, 0.5, 0.0), (0.0, 0.0, 0.0))),))
+    calls = []
+    real = physics.simulate
+    monkeypatch.setattr(physics, "simulate", lambda *a, **k: calls.append(1) or real(*a, **k))
+
+    def rightwards(**options) -> set[float]:
+        generator = ActionGenerator(compliant, CollisionChecker(compliant), **options)
+        return {p.distance for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2}
+
+    solved = rightwards()
+    assert calls
+    calls.clear()
+    unsolved = rightwards(solve_distances=False)
+    assert not calls
+    generator = ActionGenerator(compliant, CollisionChecker(compliant))
+    stall = generator.stall_per_area * 1.0  # A alone, 1 square inch
+    (pose_x,) = {p.pose[0] for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2}
+    to_goal = (7.0 - 0.5) - (pose_x + 0.075) + (9.5 - 7.0) + stall
+    assert any(abs(d - to_goal) < 1e-3 for d in unsolved)
+    assert unsolved != solved
