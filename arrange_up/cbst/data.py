@@ -23,8 +23,16 @@ How an example is drawn (``GenerationSettings`` holds every number):
   generator centres the paddle within 1.15 in of the part it targets; other blocks it hits
   may be further out), narrowed so its contact is certain (``MIN_OVERLAP_PADDLE``); its
   shadow ``0.02 .. 0.5`` in
-  behind the first block's shadow. The commanded reference puts the paddle's front uniformly
-  between ``PUSH_MARGIN`` beyond the fully compressed train and the wall.
+  behind the first block's shadow. The commanded reference puts the paddle's front, with
+  ``wall_push="uniform"`` (the default, and the data of every model shipped so far),
+  uniformly between ``PUSH_MARGIN`` beyond the fully compressed train and the wall; with
+  ``"wall"`` at the wall (the planner's push to a wall without ``compressed_wall_pushes``,
+  :mod:`arrange_up.planning.actions`); with ``"planner"`` where CBST's push to the wall
+  sends it under the settings' controller (:func:`arrange_up.planning.stall.wall_overdrive`
+  beyond the compressed train, for the train's blocks, the friction and density ranges below
+  and the paddle's pose uncertainty along the push; the wall itself under the servo), so
+  that the model predicts the pushes CBST plans with. The uniform draw is made in every
+  case, so the three settings draw the same scenes and rollouts.
 * Each rollout draws a state uniformly from the belief (rejecting states where blocks overlap
   each other or the wall: the thesis's non-collision constraint), the paddle's pose noise,
   the friction coefficient uniformly in ``[0.25, 0.55]`` and the part and paddle densities
@@ -80,6 +88,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.parallel import auto_chunksize, get_runner
 from arrange_up.physics.simulation import simulate
+from arrange_up.planning.stall import wall_overdrive
 
 __all__ = [
     "COMPLIANT",
@@ -87,6 +96,7 @@ __all__ = [
     "Dataset",
     "GenerationSettings",
     "ProgressCallback",
+    "WALL_PUSHES",
     "generate_dataset",
     "generate_example",
     "load_dataset",
@@ -106,6 +116,8 @@ EAST = -0.5 * math.pi
 #: change of that default does not change the training data).
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
 SERVO = Controller(kind=ControllerKind.SERVO)
+#: The values of :attr:`GenerationSettings.wall_push`.
+WALL_PUSHES = ("uniform", "wall", "planner")
 
 
 @dataclass(frozen=True)
@@ -130,6 +142,17 @@ class GenerationSettings:
     min_ok_fraction: float = 0.9
     max_blocks: int = 3
     controller: Controller = COMPLIANT
+    wall_push: str = "uniform"
+    """Where the push sends the paddle's front (module docstring): ``"uniform"`` between just
+    beyond the compressed train and the wall, ``"wall"`` at the wall, or ``"planner"`` where
+    CBST's push to the wall does."""
+
+    def __post_init__(self) -> None:
+        if self.wall_push not in WALL_PUSHES:
+            raise ValueError(
+                f"GenerationSettings.wall_push must be one of {', '.join(WALL_PUSHES)}, "
+                f"got {self.wall_push!r}"
+            )
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -150,11 +173,13 @@ class GenerationSettings:
 
     def digest(self) -> str:
         """A short hash of every setting. The controller is left out when it is the default
-        servo, so that servo data files (and the servo model's card) written before the
-        controller was a setting keep their digest."""
+        servo, and ``wall_push`` when it is ``"uniform"``, so that data files (and model
+        cards) written before they were settings keep their digest."""
         values = self.as_dict()
         if self.controller == SERVO:
             del values["controller"]
+        if self.wall_push == "uniform":
+            del values["wall_push"]
         text = json.dumps(values, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -260,6 +285,11 @@ def _draw_config(rng: np.random.Generator, n: int, s: GenerationSettings) -> _Co
     u_r = first - float(rng.uniform(*s.paddle_gap)) - front
     compressed = wall - n * d
     ref_front = float(rng.uniform(compressed + s.push_margin, wall))
+    if s.wall_push == "wall":
+        ref_front = wall
+    elif s.wall_push == "planner":
+        over = wall_overdrive(s.controller, s.friction, s.part_density, n * d * d, paddle_half[0])
+        ref_front = wall if over is None else min(wall, compressed + over)
     distance = ref_front - (u_r + 0.5 * t)
     return _Config(
         n=n,

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import click
 from rich.progress import (
     BarColumn,
@@ -13,6 +15,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
+from arrange_up.cbst.data import DEFAULT_GENERATION, WALL_PUSHES
 from arrange_up.cbst.features import TARGET_NAMES, TARGET_UNITS
 from arrange_up.cbst.model import rescore_model
 from arrange_up.cbst.model import train_cbst as run_training
@@ -91,6 +94,16 @@ def _echo_scores(scores: dict) -> None:
     "only problems with this controller.",
 )
 @click.option(
+    "--wall-push",
+    type=click.Choice(WALL_PUSHES),
+    default=DEFAULT_GENERATION.wall_push,
+    show_default=True,
+    help="Where each push sends the paddle: 'uniform' between just past the compressed train "
+    "and the wall (every shipped model's data), 'wall' at the wall, 'planner' where CBST's "
+    "push to the wall does (under compliant: past the compressed train by its worst-case "
+    "stall; docs/cbst.md).",
+)
+@click.option(
     "--test-examples",
     type=click.IntRange(1, None),
     default=library_default(run_training, "test_examples"),
@@ -138,6 +151,7 @@ def train_cbst(
     examples: int,
     rollouts_per_example: int,
     controller: str,
+    wall_push: str,
     test_examples: int,
     test_seed: int,
     seed: int,
@@ -170,6 +184,7 @@ def train_cbst(
                 workers=workers,
                 output_dir=output_dir,
                 controller=Controller(kind=ControllerKind(controller)),
+                settings=replace(DEFAULT_GENERATION, wall_push=wall_push),
                 test_examples=test_examples,
                 test_seed=test_seed,
                 backend=backend,

@@ -36,7 +36,13 @@ Distances:
   servo the repeat is a no-op the search prunes as a duplicate), unless
   ``settled_wall_pushes`` (the planner sets it for semantics that predict rather than simulate
   a push, i.e. CBST: there a repeat is a duplicate, and it narrows intervals until later
-  contacts are certain);
+  contacts are certain). The manipulator's front is sent to the wall itself, except with
+  ``compressed_wall_pushes`` (the planner sets it for CBST too) under the compliant
+  controller: then to the front of the compressed train (the part and its train, by their
+  nominal extents) plus :func:`~arrange_up.planning.stall.wall_overdrive`, the worst-case
+  stall of the train and the push's pose uncertainty, because a set point at the wall presses
+  the train with the full force clip and buckles trains of two or three blocks (docs/cbst.md),
+  and because CBST's model is trained on pushes to the wall drawn so;
 * to the part's goal coordinate along the direction, when that lies ahead;
 * **narrowing**: when the part's centre is already (within ``MIN_PUSH``) at its goal
   coordinate but its spread along the direction misses the goal interval, to where the
@@ -75,9 +81,15 @@ stops short of its set point by about the resisting friction / Kp, so the distan
 coordinate and the ``push_distances`` are lengthened by the nominal stall of what the push
 moves: ``mu g rho A / Kp`` at the middle of the friction and part-density ranges, ``A`` the area
 of the pushed part and of the parts in a row ahead of it whose shadows it would reach within
-``CONTACT_GAP`` (pushes to a wall need none: their set point lies beyond the wall, and the
-force clip presses the train against it). Under the servo the stall is zero and the distances
-are as before.
+``CONTACT_GAP`` (pushes to a wall need none: their set point lies at the wall, or with
+``compressed_wall_pushes`` beyond the compressed train by more than its worst-case stall;
+:mod:`arrange_up.planning.stall`). Under the servo the stall is zero and the distances are as
+before.
+A push meant to move a part by a given travel then has its distance solved for in up to
+``SOLVER_STEPS`` noise-free simulations from the belief's centres, unless ``solve_distances``
+is off (the planner turns it off for semantics that do not simulate pushes, i.e. CBST: its
+model predicts only pushes that compress a train against a wall, and the simulations took
+half of a CBST search's time).
 
 A part is never pushed away from its own goal (beyond the goal tolerance along the direction),
 but for a detour: such a push cannot help it, and it multiplies the search's plateaus.
@@ -85,8 +97,9 @@ but for a detour: such a push cannot help it, and it multiplies the search's pla
 **Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
 against there), places of a fixture at the part's goal face, after the places of parts; a push
-to a fence on the table, as to a wall; and along that axis no push that ends in the open (to
-the goal coordinate, or narrowing) while a fence stands there or can be put down, but for a
+to a fence on the table, as to a wall (with ``compressed_wall_pushes``, the part's own
+extent plus its overdrive short of the face); and along that axis no push that ends in the open
+(to the goal coordinate, or narrowing) while a fence stands there or can be put down, but for a
 levelling push where a corner needs the part brought level with its other fence first; and for
 such a part, the manipulator centred across so that its path misses the fixtures on the table.
 Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
@@ -109,7 +122,6 @@ from dataclasses import dataclass
 from arrange_up.belief.states import IntervalBelief, wrap_angle
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import (
-    STANDARD_GRAVITY,
     ArrangementProblem,
     ControllerKind,
     ObjectKind,
@@ -119,6 +131,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
 from arrange_up.planning.fences import Fences
 from arrange_up.planning.obstacles import GAP, Obstacles, far_face
+from arrange_up.planning.stall import stall_per_area, wall_overdrive
 
 #: The wall each push direction heads for.
 _WALL_AHEAD = {"+x": "right", "-x": "left", "+y": "top", "-y": "bottom"}
@@ -167,11 +180,15 @@ class ActionGenerator:
         *,
         unclipped_pushes: bool = False,
         settled_wall_pushes: bool = False,
+        compressed_wall_pushes: bool = False,
+        solve_distances: bool = True,
     ) -> None:
         self.problem = problem
         self.checker = checker
         self.unclipped_pushes = unclipped_pushes
         self.settled_wall_pushes = settled_wall_pushes
+        self.compressed_wall_pushes = compressed_wall_pushes
+        self.solve_distances = solve_distances
         hints = problem.planning
         self.directions = tuple(hints.push_directions or DIRECTIONS)
         self.push_distances = tuple(hints.push_distances or ())
@@ -180,7 +197,7 @@ class ActionGenerator:
         self.push_unc = problem.uncertainty.push
         self.manipulators = tuple(_describe(spec) for spec in problem.manipulators)
         self.compliant = problem.controller.kind is ControllerKind.COMPLIANT
-        self.stall_per_area = _stall_per_area(problem)
+        self.stall_per_area = stall_per_area(problem)
         self.areas = {spec.name: spec.shape.area for spec in problem.parts}
         self.wall_trains = self._wall_trains()
         walls = set(problem.table.walls)
@@ -487,7 +504,7 @@ class ActionGenerator:
                 if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
                     for d, travel in group:
                         push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
-                        if self.stall_per_area and travel is not None:
+                        if self.stall_per_area and self.solve_distances and travel is not None:
                             distance = self._solve_distance(push, name, axis, sign, travel, belief)
                             push = Push(push.manipulator, push.pose, distance)
                         pushes.append(push)
@@ -659,7 +676,9 @@ class ActionGenerator:
             )
         ):
             boundary = size if sign > 0 else 0.0
-            candidates.append(sign * boundary - front)
+            candidates.append(
+                self._stop_front(sign * boundary, (name, *train), belief, axis) - front
+            )
         # A fence (a fixture on the table at the part's goal face) is pushed against as the
         # wall is; where a fence is needed and one is there or can be put down, the pushes
         # that end in the open along this axis are not offered: by the problem's own noise
@@ -674,7 +693,7 @@ class ActionGenerator:
                 and target is not None
                 and self._inside_goal(interval, target, axis)
             ):
-                candidates.append(sign * face - front)
+                candidates.append(self._stop_front(sign * face, (name,), belief, axis) - front)
             fenced = self.fences.needed(name, axis) and (
                 face is not None or (name, axis, sign) in (routes or {})
             )
@@ -793,6 +812,30 @@ class ActionGenerator:
             cover=True,
         )
 
+    def _stop_front(
+        self, stop: float, parts: tuple[str, ...], belief: IntervalBelief, axis: int
+    ) -> float:
+        """Where (signed coordinate along the push) a push of ``parts``, the pushed part and
+        the train ahead of it, against the wall or fence face at ``stop`` sends the
+        manipulator's front: the face itself; with ``compressed_wall_pushes`` under the
+        compliant controller, the front of the compressed train (the parts' nominal extents
+        along the push, at their belief centres) plus its
+        :func:`~arrange_up.planning.stall.wall_overdrive`."""
+        if not self.compressed_wall_pushes:
+            return stop
+        u = self.problem.uncertainty
+        area = sum(self.areas[q] for q in parts)
+        over = wall_overdrive(
+            self.problem.controller, u.friction, u.part_density, area, self.push_unc[axis]
+        )
+        if over is None:
+            return stop
+        length = 0.0
+        for q in parts:
+            box = self.checker.shadow_box(q, belief.get(q).center, (0.0, 0.0, 0.0))  # type: ignore[union-attr]
+            length += box[axis + 2] - box[axis]
+        return min(stop, stop - length + over)
+
     def _settled(self, parts: tuple[str, ...], belief: IntervalBelief, axis: int) -> bool:
         """Whether every one of ``parts`` lies within its goal interval along ``axis`` in every
         state of ``belief`` (its interval inside the target +- the tolerance)."""
@@ -895,18 +938,6 @@ class ActionGenerator:
     # -- helpers ---------------------------------------------------------------------------
     def _shadows(self, belief: IntervalBelief):
         return [(name, iv.center, iv.half) for name, iv in belief.objects]
-
-
-def _stall_per_area(problem: ArrangementProblem) -> float:
-    """Inches a compliant push stops short per square inch of part it moves, at the middle of
-    the problem's friction and part-density ranges (``mu g rho / Kp``; 0 under the servo)."""
-    controller = problem.controller
-    if controller.kind is not ControllerKind.COMPLIANT:
-        return 0.0
-    u = problem.uncertainty
-    friction = 0.5 * (u.friction[0] + u.friction[1])
-    density = 0.5 * (u.part_density[0] + u.part_density[1])
-    return friction * STANDARD_GRAVITY * density / controller.kp
 
 
 def _describe(spec: ObjectSpec) -> _Manipulator:

@@ -98,6 +98,8 @@ class BeliefTask:
                 checker,
                 unclipped_pushes=model.refuses_uncertain_contacts,
                 settled_wall_pushes=not model.simulates_pushes,
+                compressed_wall_pushes=not model.simulates_pushes,
+                solve_distances=model.simulates_pushes,
             )
             estimate = make_heuristic(heuristic, problem, goal, checker, generator)
         except BaseException:

@@ -42,7 +42,10 @@ A push returns ``None`` (no prediction) whenever the contact graph says so (see
 :mod:`arrange_up.cbst.contact_graph`), when the push is not axis-aligned, when the
 manipulator or a pushed object is not the paddle/block the model was trained on, when a
 feature lies outside the training domain, or when the model predicts that the train may
-buckle (predicted ``slip`` above :data:`~arrange_up.cbst.features.BUCKLE_LIMIT`).
+buckle (predicted ``slip`` above :data:`~arrange_up.cbst.features.BUCKLE_LIMIT`), and, for a
+model trained on the planner's pushes to the wall (its card's ``wall_push`` is ``"planner"``,
+:mod:`arrange_up.cbst.data`), when the push sends the paddle elsewhere than those did
+(:data:`TRAINED_PUSH_REFUSAL`): such a model knows that push only.
 ``reasons`` counts the reasons, for diagnostics.
 
 ``simulations`` counts model predictions: one per feature row evaluated (one PREDICT of the
@@ -53,6 +56,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +64,7 @@ import numpy as np
 from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
 from arrange_up.cbst.choice import model_for
 from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
+from arrange_up.cbst.data import DEFAULT_GENERATION, GenerationSettings
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
 from arrange_up.cbst.model import DEFAULT_MODEL
@@ -67,6 +72,7 @@ from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
+from arrange_up.planning.stall import wall_overdrive
 
 __all__ = ["CBSTSemantics"]
 
@@ -79,6 +85,12 @@ PREDICTION_CACHE = 200_000
 NODE_CACHE = 100_000
 #: Shapes and sizes are compared with this tolerance (inches).
 _SIZE_TOL = 1e-6
+#: Why a push has no prediction from a model trained on the planner's pushes to the wall
+#: (``wall_push="planner"``) when it sends the paddle elsewhere: the model knows no other push.
+TRAINED_PUSH_REFUSAL = "the push sends the paddle elsewhere than the model's training pushes"
+#: How far (in) a push's commanded front may lie from where such a model's training pushes
+#: sent it: the rounding of generated poses (1e-6 in) and distances (1e-4 in), with room.
+TRAINED_PUSH_TOLERANCE = 1e-3
 
 
 def _r(value: float) -> float:
@@ -127,6 +139,13 @@ class CBSTSemantics:
         allowance = {int(k): float(v) for k, v in card["overshoot_allowance"].items()}
         self._allowance = allowance
         self._allowance_rate = max((v / k for k, v in allowance.items()), default=0.0)
+        # What the training pushes were (a card without settings predates them: uniform).
+        recorded = card.get("data", {}).get("settings")
+        settings = GenerationSettings.from_dict(recorded) if recorded else DEFAULT_GENERATION
+        self._trained_wall_push = settings.wall_push
+        self._trained_overdrive = partial(
+            wall_overdrive, settings.controller, settings.friction, settings.part_density
+        )
         self.angles = AngleFrame.of(problem)
         self.checker = CollisionChecker(problem)
         self._order = {spec.name: i for i, spec in enumerate(problem.objects)}
@@ -238,6 +257,10 @@ class CBSTSemantics:
         if not self._is_paddle(spec):
             return self._refuse(f"{push.manipulator!r} is not the paddle the model was trained on")
         assert wall is not None
+        if self._trained_wall_push == "planner" and not self._sent_as_trained(
+            paddle, wall, structure.length
+        ):
+            return self._refuse(TRAINED_PUSH_REFUSAL)
         by_name = {node.name: node for node in nodes}
 
         def neighbour(key):
@@ -351,6 +374,18 @@ class CBSTSemantics:
         if any(row is None for row in found):
             return None
         return np.asarray(found).reshape(-1, 4)
+
+    def _sent_as_trained(self, paddle: Paddle, wall: float, length: int) -> bool:
+        """Whether the push sends the paddle's front where the training pushes of a model
+        trained with ``wall_push="planner"`` sent it (:mod:`arrange_up.cbst.data`): past the
+        compressed train of ``length`` blocks by the training settings' ``wall_overdrive`` for
+        the paddle's pose uncertainty along the push (at the wall when that is None), within
+        :data:`TRAINED_PUSH_TOLERANCE`."""
+        d = self.block_size
+        over = self._trained_overdrive(length * d * d, paddle.half[0])
+        target = wall if over is None else min(wall, wall - length * d + over)
+        front = paddle.center[0] + 0.5 * paddle.thickness + paddle.travel
+        return abs(front - target) <= TRAINED_PUSH_TOLERANCE
 
     def _fence_ahead(self, belief, frame, paddle, wall) -> tuple[str, float, float] | None:
         """The fixture on the table that stands in for the wall ahead (module docstring):

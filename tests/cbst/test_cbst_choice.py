@@ -5,11 +5,13 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 
+from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.cbst.choice import card_controller, controller_record, model_for
 from arrange_up.cbst.data import COMPLIANT, SERVO, GenerationSettings, generate_dataset
 from arrange_up.cbst.features import TARGET_NAMES
@@ -22,10 +24,13 @@ from arrange_up.cbst.model import (
     train_cbst,
 )
 from arrange_up.cli import main
+from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.domains import load
 from arrange_up.io.resources import shipped_dir
 from arrange_up.model.problem import DEFAULT_CONTROLLER, Controller, ControllerKind
+from arrange_up.planning.actions import ActionGenerator
 from arrange_up.planning.planner import plan
+from arrange_up.transitions.cbst import TRAINED_PUSH_REFUSAL, CBSTSemantics
 
 
 def _with(problem, **controller):
@@ -220,3 +225,38 @@ def test_rescore_cli_refuses_an_unknown_model_with_exit_2(tmp_path):
     args = ["rescore-cbst", "no-such", "--data", str(tmp_path / "d"), "--test-data", "t"]
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 2 and "unknown CBST model 'no-such'" in result.output
+
+
+def test_a_model_of_the_planners_wall_pushes_predicts_those_pushes_only(tmp_path):
+    # Trained with wall_push="planner", a model knows the push that stops just past the
+    # compressed train (the one CBST's planner offers) and no other: a push to the wall
+    # itself is refused with TRAINED_PUSH_REFUSAL. A model of uniform pushes is not.
+    card = train_cbst(
+        examples=12,
+        rollouts_per_example=2,
+        seed=3,
+        workers=1,
+        output_dir=tmp_path,
+        settings=dataclasses.replace(GenerationSettings(), wall_push="planner"),
+        test_examples=3,
+        param_grid={"min_samples_leaf": [4]},
+        n_estimators=3,
+    )
+    assert card["data"]["settings"]["wall_push"] == "planner"
+    problem = load("blocks-2")
+    belief = IntervalBelief((("A", ObjectInterval((9.0, 0.912, 0.0), (0.1, 0.1, 0.1))),))
+
+    def wall_push(compressed: bool):
+        generator = ActionGenerator(
+            problem, CollisionChecker(problem), compressed_wall_pushes=compressed
+        )
+        rightwards = [p for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2]
+        return max(rightwards, key=lambda p: p.distance)  # the push to the wall
+
+    planner = CBSTSemantics(problem, model=tmp_path / "compliant.json")
+    assert planner.apply(belief, wall_push(compressed=True)) is not None
+    assert planner.apply(belief, wall_push(compressed=False)) is None
+    assert planner.reasons == {TRAINED_PUSH_REFUSAL: 1}
+    uniform = CBSTSemantics(problem)  # the shipped model: uniform pushes
+    uniform.apply(belief, wall_push(compressed=False))
+    assert TRAINED_PUSH_REFUSAL not in uniform.reasons

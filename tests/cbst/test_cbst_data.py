@@ -3,12 +3,26 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from arrange_up.cbst.data import generate_dataset, generate_example, load_dataset
-from arrange_up.cbst.features import FEATURE_NAMES, TARGET_NAMES, Domain, contact_type
+from arrange_up.cbst.data import (
+    DEFAULT_GENERATION,
+    WALL_PUSHES,
+    GenerationSettings,
+    generate_dataset,
+    generate_example,
+    load_dataset,
+)
+from arrange_up.cbst.features import (
+    BUCKLE_LIMIT,
+    FEATURE_NAMES,
+    TARGET_NAMES,
+    Domain,
+    contact_type,
+)
 
 ROLLOUTS = 6  # tiny: these tests check plumbing, not statistics
 
@@ -73,3 +87,28 @@ def test_generation_resumes_and_refuses_other_settings(tmp_path):
         generate_dataset(path, examples=5, rollouts=ROLLOUTS + 1, seed=4)
     with pytest.raises(ValueError, match="other parameters"):
         load_dataset(path, seed=5)
+
+
+def test_wall_push_rules_draw_the_same_scenes_and_planner_pushes_do_not_buckle():
+    # The same examples under the three rules differ only in the commanded distance: the
+    # features (the beliefs) are the same. A push to the wall presses the compliant train with
+    # the force clip and buckles some (a block ends beyond x_max by more than BUCKLE_LIMIT); a
+    # push sent just past the compressed train, as CBST's planner sends it, buckles none.
+    rules = {rule: replace(DEFAULT_GENERATION, wall_push=rule) for rule in WALL_PUSHES}
+    assert DEFAULT_GENERATION.wall_push == "uniform"
+    records = {
+        rule: [generate_example(i, 0, 20, settings) for i in range(10)]
+        for rule, settings in rules.items()
+    }
+    for rule in WALL_PUSHES:
+        assert [r["features"] for r in records[rule]] == [r["features"] for r in records["uniform"]]
+
+    def buckled(rule):
+        return sum(o > BUCKLE_LIMIT for r in records[rule] for o in r["overshoot"])
+
+    assert buckled("wall") >= 3
+    assert buckled("planner") == 0
+    # Settings digests: "uniform" keeps the digest of data made before it was a setting.
+    assert len({settings.digest() for settings in rules.values()}) == 3
+    with pytest.raises(ValueError, match="wall_push"):
+        GenerationSettings(wall_push="elsewhere")

@@ -383,6 +383,7 @@ COMMAND_CASES: dict[str, tuple[list[str], tuple[str, ...]]] = {
     "fixtures-timeout-nan": ([*QUICK_FIXTURES, "--timeout", "nan"], ("--timeout",)),
     "search-table-weight-nan": ([*QUICK_TABLE, "--weight", "nan"], ("--weight",)),
     "train-seed-negative": ([*QUICK_TRAIN, "--seed", "-1"], ("--seed",)),
+    "train-unknown-wall-push": ([*QUICK_TRAIN, "--wall-push", "far"], ("--wall-push",)),
     "train-output-in-a-file": ([*QUICK_TRAIN, "--output-dir", "{tmp}/file/m"], ("--output-dir",)),
     "train-data-in-a-file": ([*QUICK_TRAIN, "--data", "{tmp}/file/d.jsonl"], ("--data",)),
     "bench-workers-zero": (

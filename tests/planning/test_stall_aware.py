@@ -8,7 +8,10 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+import pytest
+
 import arrange_up
+import arrange_up.physics.simulation as physics
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
@@ -17,6 +20,7 @@ from arrange_up.model.problem import SERVO_CONTROLLER, Controller, ControllerKin
 from arrange_up.model.world import Push, WorldState
 from arrange_up.physics.simulation import simulate
 from arrange_up.planning.actions import ActionGenerator
+from arrange_up.planning.stall import WALL_MARGIN, wall_overdrive
 
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
 GOLDENS = Path(__file__).parents[1] / "goldens"
@@ -81,3 +85,69 @@ def test_a_train_already_within_its_goal_is_not_pushed_to_the_wall_again():
     assert pushes_right(compliant, target - 0.01, settled_wall_pushes=True)
     # A train short of its goal interval is pushed to the wall under either controller.
     assert pushes_right(compliant, target - 0.4)
+
+
+def test_cbst_pushes_to_a_wall_stop_just_past_the_compressed_train():
+    # A set point at the wall is a train length past where the compliant paddle stops, so it
+    # presses the train with the force clip and buckles it; with compressed_wall_pushes (what
+    # the planner gives CBST) the paddle's front is sent past the compressed train by its
+    # worst-case stall, its pose uncertainty along the push and WALL_MARGIN only.
+    compliant = arrange_up.load("blocks-2")
+    servo = replace(compliant, controller=SERVO_CONTROLLER)
+    none = (0.0, 0.0, 0.0)
+    belief = IntervalBelief(
+        (
+            ("A", ObjectInterval((9.3, 0.5, 0.0), none)),
+            ("B", ObjectInterval((7.0, 0.5, 0.0), none)),
+        )
+    )
+
+    def fronts_of_b_right(problem, **options) -> set[float]:
+        generator = ActionGenerator(problem, CollisionChecker(problem), **options)
+        return {
+            round(p.pose[0] + 0.075 + p.distance, 4)  # the paddle's front at the set point
+            for p in generator.pushes(belief)
+            if p.pose[2] == -math.pi / 2 and p.pose[0] < 7.0
+        }
+
+    wall = 10.0
+    # worst-case stall of two 1-inch blocks (mu 0.55, density 0.15, Kp 300), the push's
+    # +-0.05 in along x, and the margin
+    overdrive = 0.55 * 386.09 * 0.15 * 2.0 / 300.0 + 0.05 + WALL_MARGIN
+    assert overdrive == pytest.approx(
+        wall_overdrive(COMPLIANT, (0.25, 0.55), (0.1, 0.15), 2.0, 0.05), abs=1e-12
+    )
+    assert wall in fronts_of_b_right(compliant)
+    compressed = fronts_of_b_right(compliant, compressed_wall_pushes=True)
+    assert wall not in compressed
+    assert any(abs(f - (wall - 2.0 + overdrive)) < 1e-3 for f in compressed)
+    # The servo's pushes to the wall go to the wall either way.
+    assert wall in fronts_of_b_right(servo, compressed_wall_pushes=True)
+
+
+def test_cbst_gets_the_stall_lengthened_distances_without_simulating_them(monkeypatch):
+    # A semantics that does not simulate pushes (CBST) only predicts pushes that compress a
+    # train against a wall, so solving a push's distance in simulations (the compliant
+    # controller's goal-coordinate pushes) is turned off for it: the distance is the free
+    # travel plus the nominal stall, and nothing is simulated.
+    compliant = arrange_up.load("blocks-2")
+    belief = IntervalBelief((("A", ObjectInterval((7.0, 0.5, 0.0), (0.0, 0.0, 0.0))),))
+    calls = []
+    real = physics.simulate
+    monkeypatch.setattr(physics, "simulate", lambda *a, **k: calls.append(1) or real(*a, **k))
+
+    def rightwards(**options) -> set[float]:
+        generator = ActionGenerator(compliant, CollisionChecker(compliant), **options)
+        return {p.distance for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2}
+
+    solved = rightwards()
+    assert calls
+    calls.clear()
+    unsolved = rightwards(solve_distances=False)
+    assert not calls
+    generator = ActionGenerator(compliant, CollisionChecker(compliant))
+    stall = generator.stall_per_area * 1.0  # A alone, 1 square inch
+    (pose_x,) = {p.pose[0] for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2}
+    to_goal = (7.0 - 0.5) - (pose_x + 0.075) + (9.5 - 7.0) + stall
+    assert any(abs(d - to_goal) < 1e-3 for d in unsolved)
+    assert unsolved != solved

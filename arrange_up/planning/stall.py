@@ -1,0 +1,70 @@
+"""How far a compliant push stops short of its set point, as the push generators plan for it.
+
+Under the compliant controller (:mod:`arrange_up.physics.simulation`) the paddle tracks its set
+point through a low-gain PD, so a push that moves parts lags behind the set point by about the
+resisting friction / Kp and stops short by as much. Under the servo it does not stall (0).
+
+* :func:`stall_per_area`: inches of nominal stall per square inch of part pushed (friction and
+  part density at the middle of their ranges): what the generators add to a push meant to move
+  a part by a given travel (:mod:`arrange_up.planning.actions`).
+* :func:`wall_overdrive`: how far beyond the fully compressed train a push *to a wall* sets its
+  set point. A set point at the wall itself, a whole train length beyond where the paddle stops,
+  leaves the PD's error at that length, so the paddle presses the train with the full force clip
+  (400 against the few tens the train's friction needs), and a compressed train of two or three
+  blocks buckles: a block squeezes out sideways (``docs/cbst.md``, measured by
+  ``benchmarks/cbst_wall_push.py``). The overdrive is the stall at the *upper* ends of the
+  friction and density ranges (so every draw of the problem still compresses the train), plus
+  the paddle's pose uncertainty along the push (its start, hence its set point, may lie that
+  much behind), plus :data:`WALL_MARGIN`.
+
+With ``wall_push="planner"`` the CBST training data (:mod:`arrange_up.cbst.data`) draws its
+pushes to the wall with the same :func:`wall_overdrive`, so that the model predicts the pushes
+the planner offers (the planner gives CBST these pushes: ``compressed_wall_pushes`` in
+:mod:`arrange_up.planning.actions`; the particle semantics still push to the wall itself).
+"""
+
+from __future__ import annotations
+
+from arrange_up.model.problem import (
+    STANDARD_GRAVITY,
+    ArrangementProblem,
+    Controller,
+    ControllerKind,
+)
+
+__all__ = ["WALL_MARGIN", "stall_per_area", "wall_overdrive"]
+
+#: Inches the set point of a compliant push to a wall goes beyond the worst-case stall and the
+#: paddle's pose uncertainty: the contact slop and what the PD still lags when it settles.
+WALL_MARGIN = 0.1
+
+
+def stall_per_area(problem: ArrangementProblem) -> float:
+    """Inches a compliant push stops short per square inch of part it moves, at the middle of
+    the problem's friction and part-density ranges (``mu g rho / Kp``; 0 under the servo)."""
+    controller = problem.controller
+    if controller.kind is not ControllerKind.COMPLIANT:
+        return 0.0
+    u = problem.uncertainty
+    friction = 0.5 * (u.friction[0] + u.friction[1])
+    density = 0.5 * (u.part_density[0] + u.part_density[1])
+    return friction * STANDARD_GRAVITY * density / controller.kp
+
+
+def wall_overdrive(
+    controller: Controller,
+    friction: tuple[float, float],
+    part_density: tuple[float, float],
+    area: float,
+    along: float,
+) -> float | None:
+    """How far (in) beyond the fully compressed train a push to a wall sets its set point
+    (module docstring): ``mu_max g rho_max area / Kp + along + WALL_MARGIN`` under the compliant
+    controller, for a train of ``area`` square inches of parts, friction and part density in
+    the given ranges and the paddle's pose uncertainty ``along`` the push (in). ``None`` under
+    the servo: its pushes to a wall go to the wall, as they always have (its stiff paddle does
+    not turn, and its trains buckled in 36 of the 3,592 training rows)."""
+    if controller.kind is not ControllerKind.COMPLIANT:
+        return None
+    stall = friction[1] * STANDARD_GRAVITY * part_density[1] * area / controller.kp
+    return stall + along + WALL_MARGIN
