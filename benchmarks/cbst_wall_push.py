@@ -16,7 +16,7 @@ differs):
   stays at that length, so it presses the train with the full force clip;
 * ``uniform``: sent uniformly between just past the compressed train and the wall (the data of
   the shipped models);
-* ``planner``: sent past the compressed train by ``arrange_up.planning.stall.wall_overdrive``
+* ``planner``: sent past the compressed train by ``arrange_up.physics.stall.wall_overdrive``
   (the worst-case stall of the train, the paddle's pose uncertainty along the push and a
   margin): CBST's push to the wall.
 
@@ -56,7 +56,7 @@ from arrange_up.cbst.data import (
 from arrange_up.cbst.features import BUCKLE_LIMIT
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.physics.simulation import simulate
-from arrange_up.planning.stall import wall_overdrive
+from arrange_up.physics.stall import wall_overdrive
 
 
 def measure(rule: str, examples: int, rollouts: int, seed: int, controller) -> dict:

@@ -28,7 +28,7 @@ How an example is drawn (``GenerationSettings`` holds every number):
   uniformly between ``PUSH_MARGIN`` beyond the fully compressed train and the wall; with
   ``"wall"`` at the wall (the planner's push to a wall without ``compressed_wall_pushes``,
   :mod:`arrange_up.planning.actions`); with ``"planner"`` where CBST's push to the wall
-  sends it under the settings' controller (:func:`arrange_up.planning.stall.wall_overdrive`
+  sends it under the settings' controller (:func:`arrange_up.physics.stall.wall_overdrive`
   beyond the compressed train, for the train's blocks, the friction and density ranges below
   and the paddle's pose uncertainty along the push; the wall itself under the servo), so
   that the model predicts the pushes CBST plans with. The uniform draw is made in every
@@ -88,7 +88,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.parallel import auto_chunksize, get_runner
 from arrange_up.physics.simulation import simulate
-from arrange_up.planning.stall import wall_overdrive
+from arrange_up.physics.stall import wall_overdrive
 
 __all__ = [
     "COMPLIANT",

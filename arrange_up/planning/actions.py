@@ -39,7 +39,7 @@ Distances:
   contacts are certain). The manipulator's front is sent to the wall itself, except with
   ``compressed_wall_pushes`` (the planner sets it for CBST too) under the compliant
   controller: then to the front of the compressed train (the part and its train, by their
-  nominal extents) plus :func:`~arrange_up.planning.stall.wall_overdrive`, the worst-case
+  nominal extents) plus :func:`~arrange_up.physics.stall.wall_overdrive`, the worst-case
   stall of the train and the push's pose uncertainty, because a set point at the wall presses
   the train with the full force clip and buckles trains of two or three blocks (docs/cbst.md),
   and because CBST's model is trained on pushes to the wall drawn so;
@@ -83,7 +83,7 @@ moves: ``mu g rho A / Kp`` at the middle of the friction and part-density ranges
 of the pushed part and of the parts in a row ahead of it whose shadows it would reach within
 ``CONTACT_GAP`` (pushes to a wall need none: their set point lies at the wall, or with
 ``compressed_wall_pushes`` beyond the compressed train by more than its worst-case stall;
-:mod:`arrange_up.planning.stall`). Under the servo the stall is zero and the distances are as
+:mod:`arrange_up.physics.stall`). Under the servo the stall is zero and the distances are as
 before.
 A push meant to move a part by a given travel then has its distance solved for in up to
 ``SOLVER_STEPS`` noise-free simulations from the belief's centres, unless ``solve_distances``
@@ -129,9 +129,9 @@ from arrange_up.model.problem import (
     Pose,
 )
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
+from arrange_up.physics.stall import stall_per_area, wall_overdrive
 from arrange_up.planning.fences import Fences
 from arrange_up.planning.obstacles import GAP, Obstacles, far_face
-from arrange_up.planning.stall import stall_per_area, wall_overdrive
 
 #: The wall each push direction heads for.
 _WALL_AHEAD = {"+x": "right", "-x": "left", "+y": "top", "-y": "bottom"}
@@ -820,7 +820,7 @@ class ActionGenerator:
         manipulator's front: the face itself; with ``compressed_wall_pushes`` under the
         compliant controller, the front of the compressed train (the parts' nominal extents
         along the push, at their belief centres) plus its
-        :func:`~arrange_up.planning.stall.wall_overdrive`."""
+        :func:`~arrange_up.physics.stall.wall_overdrive`."""
         if not self.compressed_wall_pushes:
             return stop
         u = self.problem.uncertainty

@@ -72,7 +72,7 @@ from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
-from arrange_up.planning.stall import wall_overdrive
+from arrange_up.physics.stall import wall_overdrive
 
 __all__ = ["CBSTSemantics"]
 

@@ -19,8 +19,8 @@ from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.problem import SERVO_CONTROLLER, Controller, ControllerKind
 from arrange_up.model.world import Push, WorldState
 from arrange_up.physics.simulation import simulate
+from arrange_up.physics.stall import WALL_MARGIN, wall_overdrive
 from arrange_up.planning.actions import ActionGenerator
-from arrange_up.planning.stall import WALL_MARGIN, wall_overdrive
 
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
 GOLDENS = Path(__file__).parents[1] / "goldens"

@@ -1,4 +1,6 @@
-"""How far a compliant push stops short of its set point, as the push generators plan for it.
+"""How far a compliant push stops short of its set point, as the push generators plan for it
+(a fact of the controller, kept with the physics so that the training data, the CBST semantics
+and the action generators, rooms above it, share it).
 
 Under the compliant controller (:mod:`arrange_up.physics.simulation`) the paddle tracks its set
 point through a low-gain PD, so a push that moves parts lags behind the set point by about the
