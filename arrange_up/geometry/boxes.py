@@ -21,6 +21,7 @@ __all__ = [
     "box_contains",
     "box_corners",
     "box_of",
+    "box_row",
     "boxes_overlap",
     "swept_box",
     "wall_boxes",
@@ -56,6 +57,30 @@ def boxes_overlap(a: Box, b: Box, tol: float = 0.0) -> bool:
     ``tol`` makes near-misses count as overlapping (a safety margin).
     """
     return (min(a[2], b[2]) - max(a[0], b[0]) > tol) and (min(a[3], b[3]) - max(a[1], b[1]) > tol)
+
+
+def box_row(
+    boxes: dict[str, Box], first: str, axis: int, sign: int, slack: float
+) -> tuple[tuple[str, ...], float]:
+    """The row of ``boxes`` that starts at ``first`` and runs along ``axis`` towards ``sign``
+    (+1 or -1): each next box overlaps the previous one across the axis and its near face lies
+    within ``slack`` of the previous one's far face. Returns the names after ``first``, in order,
+    and the signed coordinate (``sign`` times the coordinate) of the last box's far face."""
+    other = 1 - axis
+    box, row = boxes[first], [first]
+    while True:
+        front = box[axis + 2] if sign > 0 else -box[axis]
+        ahead = [
+            q
+            for q, b in boxes.items()
+            if q not in row
+            and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
+            and abs((b[axis] if sign > 0 else -b[axis + 2]) - front) <= slack
+        ]
+        if not ahead:
+            return tuple(row[1:]), front
+        row.append(ahead[0])
+        box = boxes[ahead[0]]
 
 
 def box_contains(outer: Box, inner: Box, tol: float = 1e-9) -> bool:

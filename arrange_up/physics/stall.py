@@ -9,6 +9,9 @@ resisting friction / Kp and stops short by as much. Under the servo it does not 
 * :func:`stall_per_area`: inches of nominal stall per square inch of part pushed (friction and
   part density at the middle of their ranges): what the generators add to a push meant to move
   a part by a given travel (:mod:`arrange_up.planning.actions`).
+* :func:`stall_spread`: half the range of that stall over the friction and density ranges: how
+  much less precisely than its push noise a push ending in the open stops its part
+  (:mod:`arrange_up.planning.fences`).
 * :func:`wall_overdrive`: how far beyond the fully compressed train a push *to a wall* sets its
   set point. A set point at the wall itself, a whole train length beyond where the paddle stops,
   leaves the PD's error at that length, so the paddle presses the train with the full force clip
@@ -34,7 +37,7 @@ from arrange_up.model.problem import (
     ControllerKind,
 )
 
-__all__ = ["WALL_MARGIN", "stall_per_area", "wall_overdrive"]
+__all__ = ["WALL_MARGIN", "stall_per_area", "stall_spread", "wall_overdrive"]
 
 #: Inches the set point of a compliant push to a wall goes beyond the worst-case stall and the
 #: paddle's pose uncertainty: the contact slop and what the PD still lags when it settles.
@@ -51,6 +54,18 @@ def stall_per_area(problem: ArrangementProblem) -> float:
     friction = 0.5 * (u.friction[0] + u.friction[1])
     density = 0.5 * (u.part_density[0] + u.part_density[1])
     return friction * STANDARD_GRAVITY * density / controller.kp
+
+
+def stall_spread(problem: ArrangementProblem) -> float:
+    """Half the range of the compliant controller's stall per square inch of part moved, over
+    the problem's friction and part-density ranges (0 under the servo)."""
+    controller = problem.controller
+    if controller.kind is not ControllerKind.COMPLIANT:
+        return 0.0
+    u = problem.uncertainty
+    low = u.friction[0] * u.part_density[0]
+    high = u.friction[1] * u.part_density[1]
+    return 0.5 * (high - low) * STANDARD_GRAVITY / controller.kp
 
 
 def wall_overdrive(

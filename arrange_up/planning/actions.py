@@ -120,6 +120,7 @@ import math
 from dataclasses import dataclass
 
 from arrange_up.belief.states import IntervalBelief, wrap_angle
+from arrange_up.geometry.boxes import box_row
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import (
     ArrangementProblem,
@@ -239,24 +240,10 @@ class ActionGenerator:
         for part in goal.parts:
             for direction, (ux, uy) in DIRECTIONS.items():
                 axis, sign = (0, int(ux)) if ux else (1, int(uy))
-                other = 1 - axis
-                box, train = boxes[part], [part]
-                while True:
-                    front = box[axis + 2] if sign > 0 else -box[axis]
-                    ahead = [
-                        q
-                        for q, b in boxes.items()
-                        if q not in train
-                        and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
-                        and abs((b[axis] if sign > 0 else -b[axis + 2]) - front) <= slack
-                    ]
-                    if not ahead:
-                        break
-                    train.append(ahead[0])
-                    box = boxes[ahead[0]]
+                train, front = box_row(boxes, part, axis, sign, slack)
                 wall = (width if axis == 0 else depth) if sign > 0 else 0.0
                 held = abs(sign * wall - front) <= slack
-                trains[(part, direction)] = tuple(train[1:]) if held else None
+                trains[(part, direction)] = train if held else None
         return trains
 
     # -- all candidates --------------------------------------------------------------------

@@ -68,9 +68,11 @@ import math
 from collections.abc import Sequence
 
 from arrange_up.belief.states import IntervalBelief, fixture_turns
+from arrange_up.geometry.boxes import box_row
 from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.model.problem import STANDARD_GRAVITY, ArrangementProblem, ControllerKind, Pose
+from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import Place
+from arrange_up.physics.stall import stall_spread
 
 _ZERO = (0.0, 0.0, 0.0)
 #: A fence must cover the part's centre across the push with this fraction of the part's width
@@ -94,18 +96,6 @@ def fixture_angles(problem: ArrangementProblem, name: str) -> list[float]:
     """The distinct right-angle turns at which fixture ``name`` is placed, by the repair's grid
     and by fences (:func:`~arrange_up.belief.states.fixture_turns`)."""
     return list(fixture_turns(problem.object(name).shape))
-
-
-def stall_spread(problem: ArrangementProblem) -> float:
-    """Half the range of the compliant controller's stall per square inch of part moved, over
-    the problem's friction and part-density ranges (0 under the servo)."""
-    controller = problem.controller
-    if controller.kind is not ControllerKind.COMPLIANT:
-        return 0.0
-    u = problem.uncertainty
-    low = u.friction[0] * u.part_density[0]
-    high = u.friction[1] * u.part_density[1]
-    return 0.5 * (high - low) * STANDARD_GRAVITY / controller.kp
 
 
 class Fences:
@@ -216,22 +206,7 @@ class Fences:
         key = (part, axis, sign)
         if key not in self._trains:
             slack = 2.0 * max(self.problem.goal.tolerance[:2]) + 1e-6
-            other = 1 - axis
-            box, train = self.goal_boxes[part], [part]
-            while True:
-                front = box[axis + 2] if sign > 0 else -box[axis]
-                ahead = [
-                    q
-                    for q, b in self.goal_boxes.items()
-                    if q not in train
-                    and min(b[other + 2], box[other + 2]) - max(b[other], box[other]) > 1e-6
-                    and abs((b[axis] if sign > 0 else -b[axis + 2]) - front) <= slack
-                ]
-                if not ahead:
-                    break
-                train.append(ahead[0])
-                box = self.goal_boxes[ahead[0]]
-            self._trains[key] = tuple(train[1:])
+            self._trains[key] = box_row(self.goal_boxes, part, axis, sign, slack)[0]
         return self._trains[key]
 
     # -- where fences go -----------------------------------------------------------------------
