@@ -85,6 +85,7 @@ of the pushed part and of the parts in a row ahead of it whose shadows it would 
 ``compressed_wall_pushes`` beyond the compressed train by more than its worst-case stall;
 :mod:`arrange_up.physics.stall`). Under the servo the stall is zero and the distances are as
 before.
+
 A push meant to move a part by a given travel then has its distance solved for in up to
 ``SOLVER_STEPS`` noise-free simulations from the belief's centres, unless ``solve_distances``
 is off (the planner turns it off for semantics that do not simulate pushes, i.e. CBST: its

@@ -23,13 +23,12 @@ shadow clears the obstacle by ``GAP``, so a part moved round an obstacle is no l
 
 from __future__ import annotations
 
+from arrange_up.geometry.boxes import Box
 from arrange_up.geometry.collision import CollisionChecker
 
 #: Gap (in) kept between a part's shadow and an obstacle: a push cut short stops the part's
 #: shadow this far before the obstacle, and a detour moves it this far clear of the obstacle.
 GAP = 0.1
-
-Box = tuple[float, float, float, float]  # (xmin, ymin, xmax, ymax)
 
 
 def near_face(box: Box, axis: int, sign: int) -> float:
