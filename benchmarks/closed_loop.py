@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import statistics
 import sys
 from pathlib import Path
@@ -156,15 +157,27 @@ def _rate(records: list[EpisodeRecord]) -> str:
     return f"{good}/{len(records)} = {rate:.0f} % ({100 * low:.0f}–{100 * high:.0f})"
 
 
+def _sign_test(won: int, lost: int) -> float:
+    """Two-sided exact sign test of the paired episodes that only one mode got right: the
+    chance of a split at least this uneven if either mode were as likely to win each."""
+    n = won + lost
+    if n == 0:
+        return 1.0
+    tail = sum(math.comb(n, k) for k in range(min(won, lost) + 1)) / 2**n
+    return min(1.0, 2 * tail)
+
+
 def table(out: Path) -> str:
     """Every closed-loop record in ``out`` beside its open-loop partner, on the episodes both
     hold (paired), as a Markdown table: both rates with their 95% Wilson intervals, the
     closed loop's replans per episode, median seconds per replan, model failures, failures by
-    kind, and the replanning settings its header records."""
+    kind, the episodes only the closed (won) or only the open loop (lost) got right with the
+    sign test's p of that split, and the replanning settings its header records."""
     lines = [
         "| run | open loop | closed loop | replans / episode | median s / replan "
-        "| model failures | closed-loop failures (goal / action / rest / off) | replanning |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| model failures | closed-loop failures (goal / action / rest / off) "
+        "| episodes won / lost by closing the loop (sign test p) | replanning |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for path in sorted(out.glob("*.closed.jsonl")):
         label = path.name.removesuffix(".closed.jsonl")
@@ -191,10 +204,13 @@ def table(out: Path) -> str:
             how = f"{s['semantics']}, {s['particles']} particles"
         how += f", {s['max_nodes']} nodes, {s['budget']:g} s"
         how += "" if s.get("adapt") else ", no adapt"
+        won = sum(closed[i].success and not opened[i].success for i in common)
+        lost = sum(opened[i].success and not closed[i].success for i in common)
         lines.append(
             f"| {label} | {_rate([opened[i] for i in common])} | {_rate(c)} | "
             f"{statistics.fmean(len(e.replans) for e in c):.2f} | {median} | "
-            f"{sum(len(e.model_failures) for e in c)} | {counts} | {how} |"
+            f"{sum(len(e.model_failures) for e in c)} | {counts} | "
+            f"{won} / {lost} ({_sign_test(won, lost):.2g}) | {how} |"
         )
     return "\n".join(lines)
 
