@@ -507,19 +507,13 @@ class ActionGenerator:
         on the table (:meth:`~arrange_up.planning.fences.Fences.clear_paths`), for a part that
         needs a fence."""
         other = 1 - axis
-        reach = 0.5 * manip.length - 0.1
-        low_lim, high_lim = self._across_limits(other)
-        span = (
-            max(interval.center[other] - reach, low_lim - m_box[other]),
-            min(interval.center[other] + reach, high_lim - m_box[other + 2]),
-        )
         return self.fences.clear_paths(
             name,
             belief,
             axis,
             sign,
             centres,
-            span,
+            self._across_span(manip, interval, other, m_box),
             (along + m_box[axis], along + m_box[axis + 2]),
             (m_box[other], m_box[other + 2]),
             max(d for d, _ in distances),
@@ -556,10 +550,7 @@ class ActionGenerator:
         """
         other = 1 - axis
         centre = interval.center[other]
-        reach = 0.5 * manip.length - 0.1
-        low_lim, high_lim = self._across_limits(other)
-        low = max(centre - reach, low_lim - m_box[other])
-        high = min(centre + reach, high_lim - m_box[other + 2])
+        low, high = self._across_span(manip, interval, other, m_box)
         if low > high:
             return []
         a_lo, a_hi = along + m_box[axis], along + m_box[axis + 2]
@@ -613,6 +604,17 @@ class ActionGenerator:
                 return [allowed[0]] if abs(value - allowed[0]) <= 1e-6 else [allowed[0], value]
         return [allowed[0]]
 
+    def _across_span(self, manip, interval, other: int, m_box) -> tuple[float, float]:
+        """The range of centres across the push (along axis ``other``) at which the
+        manipulator's long side covers the part's centre with 0.1 in to spare and its approach
+        shadow (extents ``m_box``) keeps clear of the walls; empty (low > high) if none."""
+        reach = 0.5 * manip.length - 0.1
+        low_lim, high_lim = self._across_limits(other)
+        return (
+            max(interval.center[other] - reach, low_lim - m_box[other]),
+            min(interval.center[other] + reach, high_lim - m_box[other + 2]),
+        )
+
     def _across_limits(self, other: int) -> tuple[float, float]:
         """The coordinate range across a push that keeps clear of walls on that axis."""
         walls = set(self.problem.table.walls)
@@ -641,7 +643,8 @@ class ActionGenerator:
         ``detour``: a sideways travel round an obstacle (:meth:`_detours`); ``away``: the push
         moves the part away from its goal, so only the detour is offered."""
         size = self.problem.table.size[axis]
-        wall = {(0, 1): "right", (0, -1): "left", (1, 1): "top", (1, -1): "bottom"}[(axis, sign)]
+        direction = _DIRECTION_OF[(axis, sign)]
+        wall = _WALL_AHEAD[direction]
         nominal = self.checker.shadow_box(name, interval.center, (0.0, 0.0, 0.0))
         rear = sign * (nominal[axis] if sign > 0 else nominal[axis + 2])
         gap = rear - front  # nominal free travel before contact
@@ -651,7 +654,6 @@ class ActionGenerator:
                 name, interval, axis, sign, front, gap, [(gap + detour + stall, detour)]
             )
         candidates = []
-        direction = _DIRECTION_OF[(axis, sign)]
         train = self.wall_trains.get((name, direction), ())
         if (
             wall in self.problem.table.walls
