@@ -88,7 +88,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.parallel import auto_chunksize, get_runner
 from arrange_up.physics.simulation import simulate
-from arrange_up.physics.stall import wall_overdrive
+from arrange_up.physics.stall import wall_overdrive, wall_push_front
 
 __all__ = [
     "COMPLIANT",
@@ -289,7 +289,7 @@ def _draw_config(rng: np.random.Generator, n: int, s: GenerationSettings) -> _Co
         ref_front = wall
     elif s.wall_push == "planner":
         over = wall_overdrive(s.controller, s.friction, s.part_density, n * d * d, paddle_half[0])
-        ref_front = wall if over is None else min(wall, compressed + over)
+        ref_front = wall_push_front(wall, n * d, over)
     distance = ref_front - (u_r + 0.5 * t)
     return _Config(
         n=n,

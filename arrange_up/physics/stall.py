@@ -37,7 +37,7 @@ from arrange_up.model.problem import (
     ControllerKind,
 )
 
-__all__ = ["WALL_MARGIN", "stall_per_area", "stall_spread", "wall_overdrive"]
+__all__ = ["WALL_MARGIN", "stall_per_area", "stall_spread", "wall_overdrive", "wall_push_front"]
 
 #: Inches the set point of a compliant push to a wall goes beyond the worst-case stall and the
 #: paddle's pose uncertainty: the contact slop and what the PD still lags when it settles.
@@ -85,3 +85,13 @@ def wall_overdrive(
         return None
     stall = friction[1] * STANDARD_GRAVITY * part_density[1] * area / controller.kp
     return stall + along + WALL_MARGIN
+
+
+def wall_push_front(face: float, length: float, overdrive: float | None) -> float:
+    """Where a push to the wall (or fence) face at ``face`` sends the manipulator's front, as
+    a coordinate growing along the push: ``overdrive`` (:func:`wall_overdrive`) past the front
+    of the train of ``length`` compressed against the face, never beyond the face; the face
+    itself when ``overdrive`` is None (the servo)."""
+    if overdrive is None:
+        return face
+    return min(face, face - length + overdrive)

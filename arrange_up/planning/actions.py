@@ -131,7 +131,7 @@ from arrange_up.model.problem import (
     Pose,
 )
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
-from arrange_up.physics.stall import stall_per_area, wall_overdrive
+from arrange_up.physics.stall import stall_per_area, wall_overdrive, wall_push_front
 from arrange_up.planning.fences import Fences
 from arrange_up.planning.obstacles import GAP, Obstacles, far_face
 
@@ -824,7 +824,7 @@ class ActionGenerator:
         for q in parts:
             box = self.checker.shadow_box(q, belief.get(q).center, (0.0, 0.0, 0.0))  # type: ignore[union-attr]
             length += box[axis + 2] - box[axis]
-        return min(stop, stop - length + over)
+        return wall_push_front(stop, length, over)
 
     def _settled(self, parts: tuple[str, ...], belief: IntervalBelief, axis: int) -> bool:
         """Whether every one of ``parts`` lies within its goal interval along ``axis`` in every

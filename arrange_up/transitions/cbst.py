@@ -72,7 +72,7 @@ from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
 from arrange_up.model.world import Action, Pick, Place, Push
-from arrange_up.physics.stall import wall_overdrive
+from arrange_up.physics.stall import wall_overdrive, wall_push_front
 
 __all__ = ["CBSTSemantics"]
 
@@ -383,7 +383,7 @@ class CBSTSemantics:
         :data:`TRAINED_PUSH_TOLERANCE`."""
         d = self.block_size
         over = self._trained_overdrive(length * d * d, paddle.half[0])
-        target = wall if over is None else min(wall, wall - length * d + over)
+        target = wall_push_front(wall, length * d, over)
         front = paddle.center[0] + 0.5 * paddle.thickness + paddle.travel
         return abs(front - target) <= TRAINED_PUSH_TOLERANCE
 
