@@ -57,6 +57,17 @@ Distances:
   of a fixture's shadow on the table, ahead of the part that covers its centre across the push
   with a quarter of the part to spare (the paddle's front set at that face, as for a wall:
   the controller stalls with the part pressed against it);
+* **mating** (:mod:`arrange_up.planning.mating`), for a part whose relative goal holds it
+  against the reference part ahead along the push: the goal-directed push stopped short by
+  the goal tolerance while the part still misses its goal interval across the push (beside
+  the notch, with room to slide into it from the side; with ``clearance_pushes``, which the
+  planner sets for a semantics of more than one particle: a single nominal state has no
+  spread to make room for, and a deterministic plan would end with the part at its goal
+  interval's edge), and under
+  the compliant controller, while the part misses its goal interval along the push, a seating
+  push to the goal coordinate plus the part's
+  :func:`~arrange_up.physics.stall.wall_overdrive` (pressed against the reference as against a
+  wall);
 * **a detour** round obstacles (:mod:`arrange_up.planning.obstacles`): where the straight push
   to the part's goal coordinate along one axis is blocked (an obstacle's box lies across the
   part's shadow, widened by ``obstacles.GAP``, before the goal), a push along the other axis,
@@ -133,6 +144,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
 from arrange_up.physics.stall import stall_per_area, wall_overdrive, wall_push_front
 from arrange_up.planning.fences import Fences
+from arrange_up.planning.mating import Mates
 from arrange_up.planning.obstacles import GAP, Obstacles, far_face
 
 #: The wall each push direction heads for.
@@ -184,6 +196,7 @@ class ActionGenerator:
         settled_wall_pushes: bool = False,
         compressed_wall_pushes: bool = False,
         solve_distances: bool = True,
+        clearance_pushes: bool = True,
     ) -> None:
         self.problem = problem
         self.checker = checker
@@ -191,6 +204,7 @@ class ActionGenerator:
         self.settled_wall_pushes = settled_wall_pushes
         self.compressed_wall_pushes = compressed_wall_pushes
         self.solve_distances = solve_distances
+        self.clearance_pushes = clearance_pushes
         hints = problem.planning
         self.directions = tuple(hints.push_directions or DIRECTIONS)
         self.push_distances = tuple(hints.push_distances or ())
@@ -210,6 +224,7 @@ class ActionGenerator:
         }
         self.fences = Fences(problem, checker, held)
         self.obstacles = Obstacles(checker)
+        self.mates = Mates(problem)
         self.offsets = {
             spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
             for spec in problem.parts
@@ -721,6 +736,11 @@ class ActionGenerator:
                     squeezes.add(face - front)
                     travels.setdefault(face - front, None)
                     least[face - front] = gap - half
+            if not fenced and self.mates:
+                for d, part_travel in self._mating(name, interval, belief, target, axis, sign):
+                    travels.setdefault(
+                        gap + d + (stall if part_travel is not None else 0.0), part_travel
+                    )
         elif ladder and not candidates and not self.push_distances:
             # No goal position (the reference part of a relative goal): a short ladder of
             # travels, those that keep the part's nominal footprint on the table.
@@ -742,6 +762,43 @@ class ActionGenerator:
         if self.obstacles:
             return self._cut_short(name, interval, axis, sign, front, gap, result, squeezes)
         return result, set()
+
+    def _mating(
+        self, name, interval, belief, target, axis, sign
+    ) -> list[tuple[float, float | None]]:
+        """The pushes of a part whose relative goal holds it against its mate ahead along the
+        push (:mod:`arrange_up.planning.mating`), as ``(travel of the set point beyond the free
+        travel, travel of the part or None)``: the goal-directed push stopped short by the goal
+        tolerance (a travel, solved for like the goal-directed one) while the part still misses
+        its goal interval across the push, and, under the compliant
+        controller while the part's interval misses its goal interval along the push, the
+        seating push to the goal coordinate plus the part's wall overdrive (None: it stops at
+        the contact)."""
+        mate = belief.get(self.mates.reference)
+        if mate is None or not self.mates.ahead(name, target, mate.center, axis, sign):
+            return []
+        travel = sign * (target[axis] - interval.center[axis])
+        pushes: list[tuple[float, float | None]] = []
+        clear = travel - self.problem.goal.tolerance[axis]
+        # Clearance only while the slide into the notch (along the other axis) is still to
+        # come: after it, a push that stops at the goal interval's edge is no step forward.
+        if (
+            self.clearance_pushes
+            and clear > MIN_PUSH
+            and not self._inside_goal(interval, target, 1 - axis)
+        ):
+            pushes.append((clear, clear))
+        u = self.problem.uncertainty
+        over = wall_overdrive(
+            self.problem.controller,
+            u.friction,
+            u.part_density,
+            self.areas[name],
+            self.push_unc[axis],
+        )
+        if over is not None and not self._inside_goal(interval, target, axis):
+            pushes.append((travel + over, None))
+        return pushes
 
     def _cut_short(self, name, interval, axis, sign, front, gap, result, squeezes=frozenset()):
         """``result`` (sorted ``(distance, travel)`` pairs) with the pushes that jam the part on

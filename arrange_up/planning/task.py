@@ -100,6 +100,7 @@ class BeliefTask:
                 settled_wall_pushes=not model.simulates_pushes,
                 compressed_wall_pushes=not model.simulates_pushes,
                 solve_distances=model.simulates_pushes,
+                clearance_pushes=model.particles > 1,
             )
             estimate = make_heuristic(heuristic, problem, goal, checker, generator)
         except BaseException:

@@ -1,0 +1,80 @@
+"""Mates: where a relative goal holds a part against its reference part, and how to push it there.
+
+In a relative goal (``goal.relative``) a part's target is a pose in the frame of the reference
+part, and in an interlocking goal (the thesis's TZ and TT matings) the part's goal footprint
+touches the reference's with no clearance at all. A push that brings the part straight to its
+goal coordinate then jams about half its states against the reference's edge (the Z's column
+butting the end of the T's bar instead of sliding under it). The action generator
+(:mod:`arrange_up.planning.actions`) asks this module one thing: whether, along a push, the
+goal holds the part against its *mate* (the reference) *ahead* — its goal footprint, moved
+``CONTACT_PROBE`` along the push, overlaps the reference's footprint at the reference's belief
+centre — and offers two pushes for such a part and direction:
+
+* **with clearance**: the goal-directed push stopped short by the goal tolerance along the
+  push, so the part is brought beside its notch with room to slide into it from the side; only
+  while the part still misses its goal interval across the push (that slide is still to come:
+  after it, a push that ends at the goal interval's edge would only finish a plan that half
+  the world's states fail);
+* **seating**: a push past the goal coordinate by the controller's
+  :func:`~arrange_up.physics.stall.wall_overdrive` for the part (its worst-case stall plus the
+  approach noise plus a margin), which presses the part against its mate as a push to a wall
+  does: the compliant controller stalls at the contact with a force about that of the part's
+  own friction, so the part is seated whatever the friction and density, and the reference is
+  not shoved far. Only under the compliant controller (the servo ends where it is sent, so its
+  push to the goal coordinate is already the seating push) and only while the part's interval
+  along the push is not yet inside its goal interval (pressing a seated part again only
+  perturbs it, a plateau without end).
+
+Nothing of this is offered for an absolute goal, whose parts are seated against walls, fences
+and the trains of parts ahead of them instead.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+from arrange_up.geometry.shapes import footprint
+from arrange_up.model.problem import ArrangementProblem, Pose
+
+#: How far (in) a part's goal footprint is moved along a push to test whether its mate is ahead.
+CONTACT_PROBE = 0.05
+#: Overlap area (square inches) the probe must add for the mate to count as ahead: a contact
+#: face of 0.02 in or more (a corner touching only grazes, and a float's worth is noise).
+PROBE_AREA = 1e-3
+
+
+class Mates:
+    """The mate contacts of one problem's relative goal (see the module docstring)."""
+
+    def __init__(self, problem: ArrangementProblem) -> None:
+        goal = problem.goal
+        self.reference = goal.reference
+        self._parts = {spec.name: spec.shape.parts for spec in problem.parts}
+        self._ahead = lru_cache(maxsize=50_000)(self._ahead_uncached)
+
+    def __bool__(self) -> bool:
+        return self.reference is not None
+
+    def ahead(self, name: str, target: Pose, mate: Pose, axis: int, sign: int) -> bool:
+        """Whether part ``name`` at its goal ``target`` has the reference part (at ``mate``, its
+        belief centre) ahead of it along ``axis`` in direction ``sign``, touching it: moving the
+        part's footprint ``CONTACT_PROBE`` along the push adds more than ``PROBE_AREA`` to its
+        overlap with the reference's footprint. False for the reference itself and for an
+        absolute goal."""
+        if self.reference is None or name == self.reference:
+            return False
+        return self._ahead(name, _rounded(target), _rounded(mate), axis, sign)
+
+    def _ahead_uncached(self, name, target, mate, axis, sign) -> bool:
+        other = footprint(self._parts[self.reference], mate)
+        moved = list(target)
+        moved[axis] += sign * CONTACT_PROBE
+        before = footprint(self._parts[name], target).intersection(other).area
+        after = footprint(self._parts[name], tuple(moved)).intersection(other).area
+        return after - before > PROBE_AREA
+
+
+def _rounded(pose: Pose) -> Pose:
+    """``pose`` to 1e-4 (in, rad), so that the cache meets the same contact again across
+    beliefs whose centres differ by float noise only."""
+    return (round(pose[0], 4), round(pose[1], 4), round(pose[2], 4))
