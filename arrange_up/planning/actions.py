@@ -59,7 +59,8 @@ Distances:
   the controller stalls with the part pressed against it);
 * **mating** (:mod:`arrange_up.planning.mating`), for a part whose relative goal holds it
   against the reference part ahead along the push: the goal-directed push stopped short by
-  the goal tolerance while the part still misses its goal interval across the push (beside
+  the goal tolerance, or by the part's spread relative to the reference where that is wider,
+  while the part still misses its goal interval across the push (beside
   the notch, with room to slide into it from the side; with ``clearance_pushes``, which the
   planner sets for a semantics of more than one particle: a single nominal state has no
   spread to make room for, and a deterministic plan would end with the part at its goal
@@ -769,7 +770,8 @@ class ActionGenerator:
         """The pushes of a part whose relative goal holds it against its mate ahead along the
         push (:mod:`arrange_up.planning.mating`), as ``(travel of the set point beyond the free
         travel, travel of the part or None)``: the goal-directed push stopped short by the goal
-        tolerance (a travel, solved for like the goal-directed one) while the part still misses
+        tolerance, or by the part's spread relative to its mate where that is wider (a travel,
+        solved for like the goal-directed one) while the part still misses
         its goal interval across the push, and, under the compliant
         controller while the part's interval misses its goal interval along the push, the
         seating push to the goal coordinate plus the part's wall overdrive (None: it stops at
@@ -779,7 +781,10 @@ class ActionGenerator:
             return []
         travel = sign * (target[axis] - interval.center[axis])
         pushes: list[tuple[float, float | None]] = []
-        clear = travel - self.problem.goal.tolerance[axis]
+        # Room for every state to slide in: the part's spread relative to its mate (both
+        # intervals' half-widths along the push), and at least the goal tolerance.
+        room = max(self.problem.goal.tolerance[axis], interval.half[axis] + mate.half[axis])
+        clear = travel - room
         # Clearance only while the slide into the notch (along the other axis) is still to
         # come: after it, a push that stops at the goal interval's edge is no step forward.
         if (

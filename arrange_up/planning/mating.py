@@ -11,7 +11,9 @@ goal holds the part against its *mate* (the reference) *ahead* — its goal foot
 centre — and offers two pushes for such a part and direction:
 
 * **with clearance**: the goal-directed push stopped short by the goal tolerance along the
-  push, so the part is brought beside its notch with room to slide into it from the side; only
+  push, or by the part's spread relative to its mate (the two intervals' half-widths) where
+  that is wider, so that every state of the part is brought beside its notch with room to
+  slide into it from the side; only
   while the part still misses its goal interval across the push (that slide is still to come:
   after it, a push that ends at the goal interval's edge would only finish a plan that half
   the world's states fail);

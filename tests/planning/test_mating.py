@@ -86,6 +86,12 @@ def test_a_part_is_brought_beside_its_mate_with_clearance_and_seated_against_it(
     over = wall_overdrive(problem.controller, u.friction, u.part_density, 1.0, u.push[0])
     assert fronts == pytest.approx([4.8 - stall, 4.5 - stall, 4.5 - over], abs=1e-3)
     assert over > stall
+    # B spread wider than the tolerance relative to A (0.4 + 0.05 in): stopped short by that.
+    wide = pair_belief(6.0, (0.4, 0.05, 0.03))
+    stall_wide = gen._stall("B", wide, 0, -1)
+    first = west_pushes(gen, wide)[0]
+    front = first.pose[0] - PADDLE_HALF_THICKNESS - first.distance
+    assert front == pytest.approx(4.5 + 0.45 - stall_wide, abs=1e-3)
     # Level with A already (within its goal interval in y): no push that stops with clearance.
     level = west_pushes(gen, pair_belief(6.0, b_y=3.0))
     assert [pose[0] - PADDLE_HALF_THICKNESS - p.distance for p in level] == pytest.approx(
