@@ -49,6 +49,11 @@ Distances:
   nominal part would sit at the target, in both directions: the states behind the target are
   swept up to it, those ahead left alone, and the push from the other side does the rest
   (a squeeze between two pushes where no wall can do it);
+* **gathering** the reference of a relative goal
+  (:meth:`~arrange_up.planning.mating.Mates.gather`): where its spread along the push is wider
+  than the goal tolerance, a push that moves its centre by its half-width, so that every
+  state is swept to the far edge of the interval (the parts placed relative to it inherit
+  its spread, and it has no goal position to narrow it to);
 * **a ladder** of travels (``LADDER``) for a part without a goal position of its own (the
   reference of a relative goal), keeping its nominal footprint on the table, offered only
   while some goal part cannot be placed at all (the reference may have to make room);
@@ -742,14 +747,19 @@ class ActionGenerator:
                     travels.setdefault(
                         gap + d + (stall if part_travel is not None else 0.0), part_travel
                     )
-        elif ladder and not candidates and not self.push_distances:
-            # No goal position (the reference part of a relative goal): a short ladder of
-            # travels, those that keep the part's nominal footprint on the table.
-            low, high = (nominal[axis], nominal[axis + 2])
-            for d in LADDER:
-                shifted = (low + sign * d, high + sign * d)
-                if shifted[0] >= 0.0 and shifted[1] <= size:
-                    travels.setdefault(gap + d + stall, d)
+        else:
+            # No goal position (the reference part of a relative goal).
+            gather = self.mates.gather(name, interval.half[axis], axis)
+            if gather is not None:
+                travels.setdefault(gap + gather + stall, gather)
+            if ladder and not candidates and not self.push_distances:
+                # A short ladder of travels, those that keep the part's nominal footprint on
+                # the table.
+                low, high = (nominal[axis], nominal[axis + 2])
+                for d in LADDER:
+                    shifted = (low + sign * d, high + sign * d)
+                    if shifted[0] >= 0.0 and shifted[1] <= size:
+                        travels.setdefault(gap + d + stall, d)
         if detour is not None:
             travels.setdefault(gap + detour + stall, detour)
         for d in self.push_distances:

@@ -5,18 +5,17 @@ part, and in an interlocking goal (the thesis's TZ and TT matings) the part's go
 touches the reference's with no clearance at all. A push that brings the part straight to its
 goal coordinate then jams about half its states against the reference's edge (the Z's column
 butting the end of the T's bar instead of sliding under it). The action generator
-(:mod:`arrange_up.planning.actions`) asks this module one thing: whether, along a push, the
-goal holds the part against its *mate* (the reference) *ahead* — its goal footprint, moved
+(:mod:`arrange_up.planning.actions`) asks this module two things. First, whether along a push
+the goal holds the part against its *mate* (the reference) *ahead*: its goal footprint, moved
 ``CONTACT_PROBE`` along the push, overlaps the reference's footprint at the reference's belief
-centre — and offers two pushes for such a part and direction:
+centre. For such a part and direction it offers two pushes:
 
 * **with clearance**: the goal-directed push stopped short by the goal tolerance along the
   push, or by the part's spread relative to its mate (the two intervals' half-widths) where
   that is wider, so that every state of the part is brought beside its notch with room to
-  slide into it from the side; only
-  while the part still misses its goal interval across the push (that slide is still to come:
-  after it, a push that ends at the goal interval's edge would only finish a plan that half
-  the world's states fail);
+  slide into it from the side; only while the part still misses its goal interval across the
+  push (that slide is still to come: after it, a push that ends at the goal interval's edge
+  would only finish a plan that half the world's states fail);
 * **seating**: a push past the goal coordinate by the controller's
   :func:`~arrange_up.physics.stall.wall_overdrive` for the part (its worst-case stall plus the
   approach noise plus a margin), which presses the part against its mate as a push to a wall
@@ -26,6 +25,14 @@ centre — and offers two pushes for such a part and direction:
   push to the goal coordinate is already the seating push) and only while the part's interval
   along the push is not yet inside its goal interval (pressing a seated part again only
   perturbs it, a plateau without end).
+
+Second, how far to push the reference itself to *gather* it. It has no goal position, but
+every part's goal is relative to it, so its spread is every mate's: where the reference's
+interval along an axis is wider than the goal tolerance, :meth:`Mates.gather` gives the travel
+(its half-width) of a push that sweeps every state of it to the far edge of that interval,
+leaving only the push's own noise and stall (create-a-t's top bar starts +-0.35 in wide
+against a tolerance of +-0.25 in: no placement of the stem relative to its centre can succeed
+in every state).
 
 Nothing of this is offered for an absolute goal, whose parts are seated against walls, fences
 and the trains of parts ahead of them instead.
@@ -51,6 +58,7 @@ class Mates:
     def __init__(self, problem: ArrangementProblem) -> None:
         goal = problem.goal
         self.reference = goal.reference
+        self._tolerance = goal.tolerance
         self._parts = {spec.name: spec.shape.parts for spec in problem.parts}
         self._ahead = lru_cache(maxsize=50_000)(self._ahead_uncached)
 
@@ -66,6 +74,14 @@ class Mates:
         if self.reference is None or name == self.reference:
             return False
         return self._ahead(name, _rounded(target), _rounded(mate), axis, sign)
+
+    def gather(self, name: str, half: float, axis: int) -> float | None:
+        """The travel of a push that gathers the reference part ``name``, ``half`` its
+        interval's half-width along ``axis``: ``half`` where that is wider than the goal
+        tolerance, else None (and None for every other part)."""
+        if name != self.reference or half <= self._tolerance[axis]:
+            return None
+        return half
 
     def _ahead_uncached(self, name, target, mate, axis, sign) -> bool:
         other = footprint(self._parts[self.reference], mate)

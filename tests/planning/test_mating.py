@@ -122,3 +122,33 @@ def test_the_tz_mating_is_planned_with_particles():
     assert result.solved, result.reason
     final = result.beliefs[-1]
     assert GoalTest(problem).satisfied_array(final.poses, final.names())
+
+
+def test_a_reference_wider_than_the_tolerance_is_gathered_to_an_edge():
+    problem = load_problem_text(PAIR, "pair.yaml")
+    gen = ActionGenerator(problem, CollisionChecker(problem), solve_distances=False)
+    b = ObjectInterval((6.0, 3.5, 0.0), (0.05, 0.05, 0.03))
+    wide = IntervalBelief((("A", ObjectInterval((3.0, 3.0, 0.0), (0.4, 0.05, 0.03))), ("B", b)))
+    (push,) = [p for p in gen.pushes(wide) if math.isclose(p.pose[2], -math.pi / 2)]  # +x
+    # The paddle's front ends where A's rear would be had its centre moved by its half-width
+    # (every state swept to x = 3.4), plus the stall.
+    front = push.pose[0] + PADDLE_HALF_THICKNESS + push.distance
+    assert front == pytest.approx(3.4 - 0.5 + gen._stall("A", wide, 0, 1), abs=1e-3)
+    # A within the tolerance (+-0.3 in): not gathered; B is not the reference.
+    narrow = pair_belief(6.0)
+    assert not any(math.isclose(p.pose[1], 3.0) for p in gen.pushes(narrow))
+    assert Mates(problem).gather("A", 0.3, 0) is None
+    assert Mates(problem).gather("B", 0.4, 0) is None
+
+
+def test_create_a_t_is_planned_by_gathering_its_top_bar():
+    # The top bar starts +-0.35 in wide in x against a tolerance of +-0.25: before the bar
+    # could be gathered the 25-particle search was exhausted (277 nodes, the stem missing x).
+    problem = arrange_up.load("create-a-t")
+    result = arrange_up.plan(problem, particles=25, workers=1, max_nodes=300)
+    assert result.solved, result.reason
+    moved_top = [
+        b.intervals.get("top").center != a.intervals.get("top").center
+        for a, b in zip(result.beliefs, result.beliefs[1:], strict=False)
+    ]
+    assert any(moved_top)
