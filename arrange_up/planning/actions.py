@@ -100,9 +100,12 @@ tighter along an axis than a free push can stop it, and the table has no wall th
 against there), places of a fixture at the part's goal face, after the places of parts; a push
 to a fence on the table, as to a wall (with ``compressed_wall_pushes``, the part's own
 extent plus its overdrive short of the face); and along that axis no push that ends in the open
-(to the goal coordinate, or narrowing) while a fence stands there or can be put down, but for a
-levelling push where a corner needs the part brought level with its other fence first; and for
-such a part, the manipulator centred across so that its path misses the fixtures on the table.
+(to the goal coordinate, or narrowing) while a fence stands there or can be put down where it
+presses the part (any fence place, for a part that needs one along both axes), but for a
+levelling push where a corner needs the part brought level with its other fence first; where no
+fence can press it yet, a *passing* push towards the goal that stops short of the fence's place,
+also centred where it clips no shadow ahead; and for such a part, the manipulator centred
+across so that its path misses the fixtures on the table.
 Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
 
 **Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
@@ -464,8 +467,23 @@ class ActionGenerator:
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
+        # An open push of a part that needs a fence no fence can press yet is a passage (past
+        # another part, say): it is also offered where it clips no shadow ahead.
+        passing = bool(self.fences.needs) and self.fences.passing(
+            name, interval, belief, axis, sign, routes or {}
+        )
         distances, jammed = self._distances(
-            name, interval, belief, axis, sign, front_nominal, ladder, routes or {}, detour, away
+            name,
+            interval,
+            belief,
+            axis,
+            sign,
+            front_nominal,
+            ladder,
+            routes or {},
+            detour,
+            away,
+            passing,
         )
         pushes = []
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
@@ -473,16 +491,20 @@ class ActionGenerator:
             # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
             # the shadow and APPROACH_GAP add across: only a noisy approach grazes them); else
             # where it was (it stops on one as the part reaches its end).
-            centres = self._across(manip, name, interval, axis, sign, along, m_box, boxes, sweep)
+            centres = self._across(
+                manip, name, interval, axis, sign, along, m_box, boxes, sweep, passing
+            )
             if sweep and not centres:
                 other = 1 - axis
                 margin = 0.5 * (m_box[other + 2] - m_box[other] - manip.length) + APPROACH_GAP
                 shrunk = tuple(_shrink(box, other, margin) for box in sweep)
                 centres = self._across(
-                    manip, name, interval, axis, sign, along, m_box, boxes, shrunk
+                    manip, name, interval, axis, sign, along, m_box, boxes, shrunk, passing
                 )
             if sweep and not centres:
-                centres = self._across(manip, name, interval, axis, sign, along, m_box, boxes)
+                centres = self._across(
+                    manip, name, interval, axis, sign, along, m_box, boxes, (), passing
+                )
             if self.fences.needs and group:
                 centres = self._clear_of_fences(
                     manip, name, interval, belief, axis, sign, along, m_box, centres, group
@@ -536,7 +558,7 @@ class ActionGenerator:
         return list(groups.items())
 
     def _across(
-        self, manip, name, interval, axis, sign, along, m_box, boxes, sweep=()
+        self, manip, name, interval, axis, sign, along, m_box, boxes, sweep=(), unclipped=False
     ) -> list[float]:
         """Where to centre the manipulator across the push (at most two centres).
 
@@ -582,7 +604,7 @@ class ActionGenerator:
                 box[other + 2] - half_length,
                 box[other] + half_length,
             )
-            for box in (boxes if self.unclipped_pushes else [])
+            for box in (boxes if self.unclipped_pushes or unclipped else [])
             if (
                 box[axis] >= a_hi - APPROACH_GAP
                 if sign > 0
@@ -636,6 +658,7 @@ class ActionGenerator:
         routes=None,
         detour: float | None = None,
         away: bool = False,
+        passing: bool = False,
     ) -> tuple[list[tuple[float, float | None]], set[float]]:
         """Candidate travel distances of the manipulator (see the module docstring), each with
         the travel of the part it is meant for (``None`` for a push to the wall, a squeeze or a
@@ -684,8 +707,8 @@ class ActionGenerator:
                 and self._inside_goal(interval, target, axis)
             ):
                 candidates.append(self._stop_front(sign * face, (name,), belief, axis) - front)
-            fenced = self.fences.needed(name, axis) and (
-                face is not None or (name, axis, sign) in (routes or {})
+            fenced = self.fences.replaces_open_pushes(
+                name, interval, axis, sign, face, routes or {}
             )
             if fenced:
                 # a corner: the part first brought level with a fence of the other axis
@@ -705,6 +728,16 @@ class ActionGenerator:
                     level = sign * (levelling - interval.center[axis])
                     if level > MIN_PUSH:
                         travels.setdefault(gap + level + stall, level)
+            elif passing:
+                # towards the goal, short of the fence still to be put down; no narrowing:
+                # the fence does that
+                aim = min(
+                    travel,
+                    sign
+                    * (self.fences.passing_aim(name, interval, axis, sign) - interval.center[axis]),
+                )
+                if aim > MIN_PUSH:
+                    travels.setdefault(gap + aim + stall, aim)
             elif travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
             elif not self._inside_goal(interval, target, axis) and travel + half > MIN_PUSH:
