@@ -98,15 +98,16 @@ but for a detour: such a push cannot help it, and it multiplies the search's pla
 **Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
 against there), places of a fixture at the part's goal face, after the places of parts; a push
-to a fence on the table, as to a wall (with ``compressed_wall_pushes``, the part's own
-extent plus its overdrive short of the face); and along that axis no push that ends in the open
-(to the goal coordinate, or narrowing) while a fence stands there or can be put down where it
-presses the part (any fence place, for a part that needs one along both axes), but for a
-levelling push where a corner needs the part brought level with its other fence first; where no
-fence can press it yet, a *passing* push towards the goal that stops short of the fence's place,
+to a fence on the table (or to an obstacle standing at the goal face), as to a wall (with
+``compressed_wall_pushes``, the part's own extent plus its overdrive short of the face); and
+along that axis no push that ends in the open (to the goal coordinate, or narrowing) while a
+fence stands there or can be put down where it presses the part (any fence place, for a part
+that needs one along both axes), but for a levelling push where a corner needs the part
+brought level with its other fence first; where no fence can press it yet and a fixture is
+still to be put down, a *passing* push towards the goal that stops short of the fence's place,
 also centred where it clips no shadow ahead; and for such a part, the manipulator centred
-across so that its path misses the fixtures on the table.
-Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
+across so that its path misses the fixtures on the table. Nothing of this is offered for a
+problem whose parts need no fence (every shipped problem).
 
 **Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
 part at its goal while the part still misses its goal along the other axis; parts are never
@@ -698,6 +699,8 @@ class ActionGenerator:
         # they cannot stop the part within its tolerance (planning.fences).
         target = self.place_target(name, belief)
         fenced, levelling = False, None
+        # pushes meant to press the part against something fixed: not cut short (_cut_short)
+        squeezes: set[float] = set()
         if self.fences.needs and name in self.fences.goal_boxes:
             face = self.fences.face_ahead(name, interval, belief, axis, sign)
             if face is not None and not (
@@ -707,6 +710,7 @@ class ActionGenerator:
                 and self._inside_goal(interval, target, axis)
             ):
                 candidates.append(self._stop_front(sign * face, (name,), belief, axis) - front)
+                squeezes.add(candidates[-1])
             fenced = self.fences.replaces_open_pushes(
                 name, interval, axis, sign, face, routes or {}
             )
@@ -717,7 +721,6 @@ class ActionGenerator:
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
         # a narrowing push, to the contact of the rearmost state.
         least: dict[float, float] = {}
-        squeezes: set[float] = set()
         if target is not None:
             travel = sign * (target[axis] - interval.center[axis])
             half = interval.half[axis]

@@ -216,6 +216,22 @@ def test_a_part_no_fence_can_press_yet_passes_towards_it_short_of_its_place():
     assert not [p for p in gen.pushes(row) if abs(p.pose[2] + math.pi / 2) < 1e-3 and p.pose[0] > 4]
 
 
+def test_a_post_standing_at_the_goal_face_is_a_fence_already_down():
+    # squeeze-post: A's goal (x 5.5 +- 0.1) is flush with the post's left face (x 6); a free
+    # push ends within +-0.13 in, so along x A needs a fence, and the post is one: in front of
+    # it, the only push right presses A against it (no push ending in the open, as before)
+    problem = load_problem(FRESH / "squeeze-post.yaml")
+    gen = _generator(problem)
+    assert set(gen.fences.needs) == {("A", 0)}  # y: the bottom wall holds it
+    belief = IntervalBelief((("A", ObjectInterval((4.0, 0.55, 0.0), (0.2, 0.05, 0.05))),))
+    rightwards = [p for p in gen.pushes(belief) if abs(p.pose[2] + math.pi / 2) < 1e-3]
+    assert len(rightwards) == 1
+    assert rightwards[0].pose[0] + 0.075 + rightwards[0].distance == pytest.approx(6.0, abs=1e-3)
+    # above the post (it does not cover A across), the open push is offered as before
+    high = IntervalBelief((("A", ObjectInterval((2.5, 2.5, 0.0), (0.3, 0.3, 0.09))),))
+    assert [p for p in gen.pushes(high) if abs(p.pose[2] + math.pi / 2) < 1e-3]
+
+
 def test_a_fixture_put_down_must_be_picked_up_before_the_goal_is_reached(corner):
     goal = GoalTest(corner)
     at_goal = {"A": (6.0, 0.5, 0.0)}
