@@ -566,7 +566,8 @@ class ActionGenerator:
         The first is as near the part's centre as the walls, the shadows beside the approach
         and the obstacle boxes in ``sweep`` (those its travel would meet) allow, while the
         manipulator's long side still covers the part's centre (with 0.1 in to spare). With
-        ``unclipped_pushes``, when it clips the side of a shadow *ahead* of the approach (the
+        ``unclipped_pushes`` (or ``unclipped``: a passing push, :mod:`~arrange_up.planning.fences`),
+        when it clips the side of a shadow *ahead* of the approach (the
         manipulator's span overlaps that shadow's span without covering it whole, so the
         contact may or may not happen), the second is the nearest centre at which every
         shadow ahead is either missed or covered whole. Empty if no centre fits.
