@@ -115,12 +115,16 @@ but for a detour: such a push cannot help it, and it multiplies the search's pla
 **Fences** (:mod:`arrange_up.planning.fences`): where a goal part needs one (its goal is
 tighter along an axis than a free push can stop it, and the table has no wall the goal holds it
 against there), places of a fixture at the part's goal face, after the places of parts; a push
-to a fence on the table, as to a wall (with ``compressed_wall_pushes``, the part's own
-extent plus its overdrive short of the face); and along that axis no push that ends in the open
-(to the goal coordinate, or narrowing) while a fence stands there or can be put down, but for a
-levelling push where a corner needs the part brought level with its other fence first; and for
-such a part, the manipulator centred across so that its path misses the fixtures on the table.
-Nothing of this is offered for a problem whose parts need no fence (every shipped problem).
+to a fence on the table (or to an obstacle standing at the goal face), as to a wall (with
+``compressed_wall_pushes``, the part's own extent plus its overdrive short of the face); and
+along that axis no push that ends in the open (to the goal coordinate, or narrowing) while a
+fence stands there or can be put down where it presses the part (any fence place, for a part
+that needs one along both axes), but for a levelling push where a corner needs the part
+brought level with its other fence first; where no fence can press it yet and a fixture is
+still to be put down, a *passing* push towards the goal that stops short of the fence's place,
+also centred where it clips no shadow ahead; and for such a part, the manipulator centred
+across so that its path misses the fixtures on the table. Nothing of this is offered for a
+problem whose parts need no fence (every shipped problem).
 
 **Pick**: fixtures and manipulators on the table may be picked up, except a fence that holds a
 part at its goal while the part still misses its goal along the other axis; parts are never
@@ -485,8 +489,23 @@ class ActionGenerator:
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
+        # An open push of a part that needs a fence no fence can press yet is a passage (past
+        # another part, say): it is also offered where it clips no shadow ahead.
+        passing = bool(self.fences.needs) and self.fences.passing(
+            name, interval, belief, axis, sign, routes or {}
+        )
         distances, jammed = self._distances(
-            name, interval, belief, axis, sign, front_nominal, ladder, routes or {}, detour, away
+            name,
+            interval,
+            belief,
+            axis,
+            sign,
+            front_nominal,
+            ladder,
+            routes or {},
+            detour,
+            away,
+            passing,
         )
         pushes = []
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
@@ -494,16 +513,20 @@ class ActionGenerator:
             # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
             # the shadow and APPROACH_GAP add across: only a noisy approach grazes them); else
             # where it was (it stops on one as the part reaches its end).
-            centres = self._across(manip, name, interval, axis, sign, along, m_box, boxes, sweep)
+            centres = self._across(
+                manip, name, interval, axis, sign, along, m_box, boxes, sweep, passing
+            )
             if sweep and not centres:
                 other = 1 - axis
                 margin = 0.5 * (m_box[other + 2] - m_box[other] - manip.length) + APPROACH_GAP
                 shrunk = tuple(_shrink(box, other, margin) for box in sweep)
                 centres = self._across(
-                    manip, name, interval, axis, sign, along, m_box, boxes, shrunk
+                    manip, name, interval, axis, sign, along, m_box, boxes, shrunk, passing
                 )
             if sweep and not centres:
-                centres = self._across(manip, name, interval, axis, sign, along, m_box, boxes)
+                centres = self._across(
+                    manip, name, interval, axis, sign, along, m_box, boxes, (), passing
+                )
             if self.fences.needs and group:
                 centres = self._clear_of_fences(
                     manip, name, interval, belief, axis, sign, along, m_box, centres, group
@@ -557,14 +580,15 @@ class ActionGenerator:
         return list(groups.items())
 
     def _across(
-        self, manip, name, interval, axis, sign, along, m_box, boxes, sweep=()
+        self, manip, name, interval, axis, sign, along, m_box, boxes, sweep=(), unclipped=False
     ) -> list[float]:
         """Where to centre the manipulator across the push (at most two centres).
 
         The first is as near the part's centre as the walls, the shadows beside the approach
         and the obstacle boxes in ``sweep`` (those its travel would meet) allow, while the
         manipulator's long side still covers the part's centre (with 0.1 in to spare). With
-        ``unclipped_pushes``, when it clips the side of a shadow *ahead* of the approach (the
+        ``unclipped_pushes`` (or ``unclipped``: a passing push, :mod:`~arrange_up.planning.fences`),
+        when it clips the side of a shadow *ahead* of the approach (the
         manipulator's span overlaps that shadow's span without covering it whole, so the
         contact may or may not happen), the second is the nearest centre at which every
         shadow ahead is either missed or covered whole. Empty if no centre fits.
@@ -603,7 +627,7 @@ class ActionGenerator:
                 box[other + 2] - half_length,
                 box[other] + half_length,
             )
-            for box in (boxes if self.unclipped_pushes else [])
+            for box in (boxes if self.unclipped_pushes or unclipped else [])
             if (
                 box[axis] >= a_hi - APPROACH_GAP
                 if sign > 0
@@ -657,6 +681,7 @@ class ActionGenerator:
         routes=None,
         detour: float | None = None,
         away: bool = False,
+        passing: bool = False,
     ) -> tuple[list[tuple[float, float | None]], set[float]]:
         """Candidate travel distances of the manipulator (see the module docstring), each with
         the travel of the part it is meant for (``None`` for a push to the wall, a squeeze or a
@@ -696,6 +721,8 @@ class ActionGenerator:
         # they cannot stop the part within its tolerance (planning.fences).
         target = self.place_target(name, belief)
         fenced, levelling = False, None
+        # pushes meant to press the part against something fixed: not cut short (_cut_short)
+        squeezes: set[float] = set()
         if self.fences.needs and name in self.fences.goal_boxes:
             face = self.fences.face_ahead(name, interval, belief, axis, sign)
             if face is not None and not (
@@ -705,8 +732,9 @@ class ActionGenerator:
                 and self._inside_goal(interval, target, axis)
             ):
                 candidates.append(self._stop_front(sign * face, (name,), belief, axis) - front)
-            fenced = self.fences.needed(name, axis) and (
-                face is not None or (name, axis, sign) in (routes or {})
+                squeezes.add(candidates[-1])
+            fenced = self.fences.replaces_open_pushes(
+                name, interval, axis, sign, face, routes or {}
             )
             if fenced:
                 # a corner: the part first brought level with a fence of the other axis
@@ -715,7 +743,6 @@ class ActionGenerator:
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
         # a narrowing push, to the contact of the rearmost state.
         least: dict[float, float] = {}
-        squeezes: set[float] = set()
         if target is not None:
             travel = sign * (target[axis] - interval.center[axis])
             half = interval.half[axis]
@@ -726,6 +753,16 @@ class ActionGenerator:
                     level = sign * (levelling - interval.center[axis])
                     if level > MIN_PUSH:
                         travels.setdefault(gap + level + stall, level)
+            elif passing:
+                # towards the goal, short of the fence still to be put down; no narrowing:
+                # the fence does that
+                aim = min(
+                    travel,
+                    sign
+                    * (self.fences.passing_aim(name, interval, axis, sign) - interval.center[axis]),
+                )
+                if aim > MIN_PUSH:
+                    travels.setdefault(gap + aim + stall, aim)
             elif travel > MIN_PUSH:
                 travels.setdefault(gap + travel + stall, travel)
             elif not self._inside_goal(interval, target, axis) and travel + half > MIN_PUSH:

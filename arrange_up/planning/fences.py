@@ -13,10 +13,13 @@ thing is. So along an axis of an absolute goal, a goal part *needs a fence* when
   would do the job: :meth:`ActionGenerator._wall_trains`);
 * a fixture pressed against would do better than the tolerance: its own place spread,
   ``place[axis]`` plus the shift of its face over half the part's width for a place turned by
-  ``place[theta]``, is below the tolerance.
+  ``place[theta]``, is below the tolerance; or a fixed obstacle already stands as a fence: its
+  near face within the tolerance of the part's goal face, its box covering the goal's
+  coordinate across with ``COVER`` of the part to spare (a post flush with the goal). An
+  obstacle is used as a fence on the table is (*Using it*); it is never placed or picked.
 
-Only problems with fixtures and an absolute goal can need one, and no shipped problem does
-(their plans are unchanged).
+Only problems with fixtures or obstacles and an absolute goal can need one, and no shipped
+problem does (their plans are unchanged).
 
 **Where a fence goes** (:meth:`Fences.placements`): from the goal, each fixture off the table,
 at each of its distinct right-angle turns (:func:`fixture_angles`, the repair's grid angles),
@@ -37,11 +40,29 @@ place shadow on the table, touching no shadow, wall or obstacle). Offered only f
 needs the fence, is not already within its goal along the axis, and would not be pushed away
 from its goal (the push rule of :mod:`arrange_up.planning.actions`).
 
-**Using it** (:meth:`Fences.face_ahead`): any fixture on the table whose near face lies
-within the tolerance of the part's goal face, ahead of the part's shadow, and whose nominal
-footprint covers the part's centre across the push (as above), is offered as the wall is: a
-push to the face (the compliant controller's set point then lies beyond it, and the force clip
-presses the part against it).
+**Using it** (:meth:`Fences.face_ahead`): any fixture on the table or obstacle whose near
+face lies within the tolerance of the part's goal face, ahead of the part's shadow, and whose
+nominal footprint covers the part's centre across the push (as above), is offered as the wall
+is: a push to the face (the compliant controller's set point then lies beyond it, and the force
+clip presses the part against it); it is a squeeze, never cut short before the obstacle.
+
+**Open pushes give way to a fence only where it can press the part**
+(:meth:`Fences.replaces_open_pushes`): along an axis that needs a fence, the pushes that end in
+the open are not offered while a fence on the table holds the part there (``face_ahead``) or
+one can be put down that covers the part's centre across the push (as above). For a part that
+needs a fence along both axes any fence place will do (a corner: see *Levelling*).
+
+**Passing** (:meth:`Fences.passing`, :meth:`Fences.passing_aim`): a part that needs a fence
+along one axis only, and that no fence can press yet (it lies beyond every fence's reach
+across the push: a block above another, which must move along the row before it can come down
+to it), gets the open push towards its goal along that axis, but short of the fence still to
+be put down: to where its shadow at its angle spread, widened by the free push's end spread
+and by the push noise of a push across still to come, clears the place shadow of a fence at
+its goal face by ``GAP`` (a part pushed onto its goal coordinate lies where the fence must
+stand, and the fence can no longer be put down). No narrowing push is offered along that
+axis: the fence does the narrowing once the part is in front of it. A passing push is also
+offered with the manipulator centred where it clips no shadow ahead (the part it passes: a
+clipped part is dragged along in some states and not in others).
 
 **Levelling** (:meth:`Fences.level`): where both axes need a fence and no fence of the other
 axis stands, or can stand, in front of the part (its footprint would not cover the part's
@@ -119,13 +140,13 @@ class Fences:
         #: (part, axis) -> the free push's end spread, for the axes that need a fence.
         self.needs: dict[tuple[str, int], float] = {}
         self._trains: dict[tuple[str, int, int], tuple[str, ...]] = {}
-        if goal.is_relative or not problem.fixtures:
+        if goal.is_relative or not (problem.fixtures or checker.obstacle_boxes):
             return
         spread = stall_spread(problem)
         push = problem.uncertainty.push
         for part in goal.parts:
-            box = checker.shadow_box(part, goal.target(part), _ZERO)
-            self.goal_boxes[part] = box
+            self.goal_boxes[part] = checker.shadow_box(part, goal.target(part), _ZERO)
+        for part, box in self.goal_boxes.items():
             area = problem.object(part).shape.area
             for axis in (0, 1):
                 other = 1 - axis
@@ -133,8 +154,31 @@ class Fences:
                 width = box[other + 2] - box[other]
                 fence = self.place_unc[axis] + 0.5 * width * math.sin(self.place_unc[2])
                 tolerance = goal.tolerance[axis]
-                if free > tolerance > fence and not held_by_wall.get((part, axis), False):
+                if (
+                    free > tolerance
+                    and not held_by_wall.get((part, axis), False)
+                    and (
+                        (problem.fixtures and tolerance > fence)
+                        or self._obstacle_at_goal(part, axis)
+                    )
+                ):
                     self.needs[(part, axis)] = free
+
+    def _obstacle_at_goal(self, part: str, axis: int) -> bool:
+        """Whether a fixed obstacle stands as a fence for ``part`` along ``axis``: its near
+        face within the tolerance of the part's goal face (either way along the axis) and its
+        box covering the goal's coordinate across with ``COVER`` of the part to spare."""
+        tolerance = self.problem.goal.tolerance[axis]
+        at_goal = self.problem.goal.target(part)[1 - axis]
+        for sign in (1, -1):
+            goal_face = self.goal_face(part, axis, sign)
+            for box in self.checker.obstacle_boxes.values():
+                face = box[axis] if sign > 0 else box[axis + 2]
+                if abs(face - goal_face) <= tolerance and self._covers(
+                    part, box, 1 - axis, at_goal
+                ):
+                    return True
+        return False
 
     def level(
         self,
@@ -190,6 +234,86 @@ class Fences:
 
     def needed(self, part: str, axis: int) -> bool:
         return (part, axis) in self.needs
+
+    def replaces_open_pushes(
+        self,
+        part: str,
+        interval,
+        axis: int,
+        sign: int,
+        face: float | None,
+        routes: dict[tuple[str, int, int], list[Place]],
+    ) -> bool:
+        """Whether the pushes of ``part`` along ``axis`` towards ``sign`` that end in the open
+        give way to a fence (module docstring, *Using it*): the part needs one along the axis,
+        and one holds it there now (``face``, from :meth:`face_ahead`) or can be put down
+        where it would press it now (one of ``routes`` covers the part's centre across the
+        push). For a part that needs a fence along both axes any fence place will do: a corner
+        is built by sliding the part onto its second fence (:meth:`level` brings it level
+        with its first)."""
+        if not self.needed(part, axis):
+            return False
+        if face is not None:
+            return True
+        places = routes.get((part, axis, sign), ())
+        if self.needed(part, 1 - axis):
+            return bool(places)
+        return any(
+            self._covers(
+                part,
+                self.checker.shadow_box(p.obj, p.pose, _ZERO),
+                1 - axis,
+                interval.center[1 - axis],
+            )
+            for p in places
+        )
+
+    def passing(
+        self,
+        part: str,
+        interval,
+        belief: IntervalBelief,
+        axis: int,
+        sign: int,
+        routes: dict[tuple[str, int, int], list[Place]],
+    ) -> bool:
+        """Whether the pushes of ``part`` along ``axis`` towards ``sign`` are *passing* ones
+        (module docstring, *Passing*): the part needs a fence along this axis only, a fixture
+        is still to be put down for it, and no fence can press it now
+        (:meth:`replaces_open_pushes`)."""
+        if not self.problem.fixtures or not self.needed(part, axis) or self.needed(part, 1 - axis):
+            return False
+        face = self.face_ahead(part, interval, belief, axis, sign)
+        return not self.replaces_open_pushes(part, interval, axis, sign, face, routes)
+
+    def passing_aim(self, part: str, interval, axis: int, sign: int) -> float:
+        """The farthest coordinate along ``axis`` (towards ``sign``) a passing push takes
+        ``part``'s centre to: where its shadow at its angle spread, widened by the free push's
+        end spread and by the push noise of a push across still to come, clears by ``GAP``
+        the place shadow of a fence at its goal face (the fence must still be put down there)."""
+        turned = self.checker.shadow_box(part, interval.center, (0.0, 0.0, interval.half[2]))
+        reach = 0.0  # how far a fixture's place shadow reaches beyond its nominal face
+        for spec in self.problem.fixtures:
+            for theta in fixture_angles(self.problem, spec.name):
+                box = self.checker.shadow_box(spec.name, (0.0, 0.0, theta), _ZERO)
+                shadow = self.checker.shadow_box(spec.name, (0.0, 0.0, theta), self.place_unc)
+                reach = max(reach, box[axis] - shadow[axis])
+        margin = (
+            0.5 * (turned[axis + 2] - turned[axis])
+            + self.needs[(part, axis)]
+            + self.problem.uncertainty.push[axis]
+            + reach
+            + GAP
+        )
+        return self.goal_face(part, axis, sign) - sign * margin
+
+    def _covers(self, part: str, box, other: int, centre: float) -> bool:
+        """Whether a fence's nominal footprint ``box`` covers ``centre``, ``part``'s coordinate
+        across the push (along ``other``), with ``COVER`` of the part's width to spare on
+        either side."""
+        goal_box = self.goal_boxes[part]
+        spare = COVER * (goal_box[other + 2] - goal_box[other])
+        return box[other] <= centre - spare + 1e-9 and centre + spare <= box[other + 2] + 1e-9
 
     def goal_face(self, part: str, axis: int, sign: int) -> float:
         """Where a fence holding ``part`` pushed along ``axis`` towards ``sign`` stands: the
@@ -400,19 +524,15 @@ class Fences:
             return None  # its train (if any) must be on the table to be pressed against it
         goal_face = self.goal_face(part, axis, sign)
         tolerance = self.problem.goal.tolerance[axis]
-        other = 1 - axis
-        goal_box = self.goal_boxes[part]
-        centre, spare = interval.center[other], COVER * (goal_box[other + 2] - goal_box[other])
-        for spec in self.problem.fixtures:
-            fixture = belief.get(spec.name)
-            if fixture is None:
-                continue
-            box = self.checker.shadow_box(spec.name, fixture.center, _ZERO)
+        boxes = [
+            (spec.name, self.checker.shadow_box(spec.name, fixture.center, _ZERO))
+            for spec in self.problem.fixtures
+            if (fixture := belief.get(spec.name)) is not None
+        ]
+        for name, box in boxes + list(self.checker.obstacle_boxes.items()):
             face = box[axis] if sign > 0 else box[axis + 2]
-            if (
-                abs(face - goal_face) <= tolerance
-                and box[other] <= centre - spare + 1e-9
-                and centre + spare <= box[other + 2] + 1e-9
+            if abs(face - goal_face) <= tolerance and self._covers(
+                part, box, 1 - axis, interval.center[1 - axis]
             ):
-                return spec.name, face
+                return name, face
         return None

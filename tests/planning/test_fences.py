@@ -175,6 +175,63 @@ def test_a_row_is_pressed_against_one_fence_at_its_last_part():
     assert gen.fences.face_ahead("A", low[1], belief, 0, 1) == pytest.approx(7.0)
 
 
+def test_a_part_no_fence_can_press_yet_passes_towards_it_short_of_its_place():
+    # fence-row: B starts above A, beyond the reach of any bar that covers the row's y (0.5):
+    # no fence can press it, and it cannot come down to the row through A, so its open push
+    # along the row is offered (it was not while a bar could be put down anywhere), stopping
+    # short of where the bar must stand (the bar's left face at x 7), and once with the paddle
+    # clear of A (a clipped A is dragged along in some states only)
+    problem = load_problem(FRESH / "fence-row.yaml")
+    gen = _generator(problem)
+    a = ("A", ObjectInterval((2.0, 3.0, 0.0), (0.3, 0.3, 0.09)))
+    b = ("B", ObjectInterval((2.0, 4.5, 0.0), (0.3, 0.3, 0.09)))
+    belief = IntervalBelief((a, b))
+    routes = gen.fence_routes(belief)
+    assert ("B", 0, 1) in routes and gen.fences.passing("B", b[1], belief, 0, 1, routes)
+    aim = gen.fences.passing_aim("B", b[1], 0, 1)
+    # B's shadow there (its depth at its angle spread, 0.54 in), widened by the free push's
+    # end spread and one more push's noise, clears the bar's place shadow
+    bar_shadow = gen.checker.shadow_box("bar", (7.15, 1.3, 0.0), problem.uncertainty.place)
+    assert aim + 0.54 + 0.18 + 0.15 < bar_shadow[0]
+    a_top = gen.checker.shadow_box("A", a[1].center, a[1].half)[3]
+    rightwards = [
+        p for p in gen.pushes(belief) if abs(p.pose[2] + math.pi / 2) < 1e-3 and p.pose[1] > 4
+    ]
+    assert len(rightwards) == 2
+    for push in rightwards:
+        # the paddle's front carries B's rear face to about the aim's (the distance adds the
+        # compliant controller's nominal stall, under 0.15 in)
+        rear = push.pose[0] + 0.075 + push.distance
+        assert rear + 0.5 == pytest.approx(aim, abs=0.15)
+    assert (
+        min(p.pose[1] for p in rightwards) - 1.25
+        < a_top
+        < max(p.pose[1] for p in rightwards) - 1.25
+    )
+    # B at the row, where a bar can stand in front of it: the bar's push replaces the open ones
+    low = ("A", ObjectInterval((2.0, 0.55, 0.0), (0.3, 0.05, 0.09)))
+    there = ("B", ObjectInterval((6.0, 0.55, 0.0), (0.3, 0.05, 0.09)))
+    row = IntervalBelief((low, there))
+    assert not gen.fences.passing("B", there[1], row, 0, 1, gen.fence_routes(row))
+    assert not [p for p in gen.pushes(row) if abs(p.pose[2] + math.pi / 2) < 1e-3 and p.pose[0] > 4]
+
+
+def test_a_post_standing_at_the_goal_face_is_a_fence_already_down():
+    # squeeze-post: A's goal (x 5.5 +- 0.1) is flush with the post's left face (x 6); a free
+    # push ends within +-0.13 in, so along x A needs a fence, and the post is one: in front of
+    # it, the only push right presses A against it (no push ending in the open, as before)
+    problem = load_problem(FRESH / "squeeze-post.yaml")
+    gen = _generator(problem)
+    assert set(gen.fences.needs) == {("A", 0)}  # y: the bottom wall holds it
+    belief = IntervalBelief((("A", ObjectInterval((4.0, 0.55, 0.0), (0.2, 0.05, 0.05))),))
+    rightwards = [p for p in gen.pushes(belief) if abs(p.pose[2] + math.pi / 2) < 1e-3]
+    assert len(rightwards) == 1
+    assert rightwards[0].pose[0] + 0.075 + rightwards[0].distance == pytest.approx(6.0, abs=1e-3)
+    # above the post (it does not cover A across), the open push is offered as before
+    high = IntervalBelief((("A", ObjectInterval((2.5, 2.5, 0.0), (0.3, 0.3, 0.09))),))
+    assert [p for p in gen.pushes(high) if abs(p.pose[2] + math.pi / 2) < 1e-3]
+
+
 def test_a_fixture_put_down_must_be_picked_up_before_the_goal_is_reached(corner):
     goal = GoalTest(corner)
     at_goal = {"A": (6.0, 0.5, 0.0)}
