@@ -349,6 +349,7 @@ class _Builder:
         )
         self.check_placement(problem)
         self.check_goal_on_table(problem)
+        self.check_goal_overlaps(problem)
         if any(d.is_error for d in self.diagnostics):
             return None
         if validation.unsampleable(problem):
@@ -805,6 +806,20 @@ class _Builder:
                     f"such a fixture must end off it; expected (not (on-table {name})) or no "
                     "condition on it",
                 )
+
+    def check_goal_overlaps(self, problem: ArrangementProblem) -> None:
+        """Parts that overlap at their nominal goal poses are a warning
+        (:func:`~arrange_up.io.validation.goal_overlaps`), at the goal."""
+        for a, b, area in validation.goal_overlaps(problem):
+            self.error(
+                f"goal.{b}",
+                r"\(\s*:goal",
+                f"at their goal poses {a} and {b} overlap by {num(area)} square in: no plan "
+                "reaches the nominal arrangement, only poses within the tolerance that "
+                "separate them can meet the goal; expected goal poses at which the parts "
+                "touch at most",
+                severity="warning",
+            )
 
     def check_goal_on_table(self, problem: ArrangementProblem) -> None:
         """An absolute goal whose part cannot be on the table is an error; one whose part

@@ -9,7 +9,8 @@ units and points at the YAML node; the PDDL reader speaks inches and points at t
 :func:`check_placement` says, for each object placed at its nominal pose, whether its footprint
 lies outside the table and which objects placed before it it overlaps, and by how much;
 :func:`part_overlaps` which convex parts of one shape overlap (they may only touch);
-:func:`goal_outside` whether a goal pose can be met on the table; :func:`unsampleable` whether
+:func:`goal_outside` whether a goal pose can be met on the table; :func:`goal_overlaps` which
+parts overlap at their goal poses; :func:`unsampleable` whether
 collision-free initial states can be drawn from the initial uncertainty at all.
 
 Plausibility bounds on numbers that are valid but meaningless are here too
@@ -51,6 +52,7 @@ __all__ = [
     "angle_problem",
     "check_placement",
     "goal_outside",
+    "goal_overlaps",
     "part_overlaps",
     "unsampleable",
 ]
@@ -230,6 +232,28 @@ def goal_outside(
     if xmin < -tx or ymin < -ty or xmax > width + tx or ymax > depth + ty:
         return "sticks out", footprint
     return None
+
+
+def goal_overlaps(problem: ArrangementProblem) -> list[tuple[str, str, float]]:
+    """The pairs of parts whose nominal footprints at their goal poses overlap, as ``(a, b,
+    area)`` with ``area`` in square inches above :data:`AREA_TOLERANCE`, in the goal's order.
+
+    For a relative goal the reference part stands at the origin of its own frame, where the
+    other parts' targets are given. Such a goal is not impossible (a pose within the tolerance
+    may separate the parts), but it is most likely a mistake: no plan reaches the nominal
+    arrangement, and a search for one can run long before it says so.
+    """
+    goal = problem.goal
+    entries = list(goal.targets)
+    if goal.reference is not None:
+        entries.insert(0, (goal.reference, (0.0, 0.0, 0.0)))
+    footprints = [(name, _footprint(problem.object(name).shape, pose)) for name, pose in entries]
+    found = []
+    for i, (a, fa) in enumerate(footprints):
+        for b, fb in footprints[i + 1 :]:
+            if _overlap(fa, fb):
+                found.append((a, b, float(fa.intersection(fb).area)))
+    return found
 
 
 def unsampleable(problem: ArrangementProblem, draws: int = SAMPLE_DRAWS) -> bool:

@@ -148,7 +148,29 @@ class ProblemBuilder(NodeReader):
                 "every one); expected uncertainties from which particles can be drawn",
             )
             return None
+        self.check_goal_overlaps(root, problem)
         return problem
+
+    def check_goal_overlaps(self, root: Node, problem: ArrangementProblem) -> None:
+        """Parts that overlap at their nominal goal poses are a warning
+        (:func:`~arrange_up.io.validation.goal_overlaps`), at the later part's goal pose."""
+        goal = root.child("goal")
+        poses = (
+            goal.child("relative").child("poses")
+            if problem.goal.is_relative
+            else goal.child("poses")
+        )
+        nodes = {str(key.value): value for key, value in poses.entries()}
+        scale = self.units.length_out(1.0) ** 2
+        for a, b, area in validation.goal_overlaps(problem):
+            self.report.warning(
+                nodes[b],
+                None,
+                f"at their goal poses {a} and {b} overlap by {fmt(area * scale)} square "
+                f"{self.units.length}: no plan reaches the nominal arrangement, only poses "
+                "within the tolerance that separate them can meet the goal; expected goal "
+                "poses at which the parts touch at most",
+            )
 
     def check_goal_on_table(
         self, root: Node, table: Table, objects: dict[str, _Object], goal: Goal

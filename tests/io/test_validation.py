@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import dataclasses
 import random
+from pathlib import Path
 
 import pytest
 
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.pddl import load_pddl_problem_text, write_pddl_problem
+from arrange_up.io.pddl_reader import check_pddl_problem_text
 from arrange_up.io.validation import (
     AREA_TOLERANCE,
     MAX_ANGLE,
@@ -19,6 +21,7 @@ from arrange_up.io.validation import (
     angle_problem,
     check_placement,
     goal_outside,
+    goal_overlaps,
     part_overlaps,
     unsampleable,
 )
@@ -28,6 +31,8 @@ from arrange_up.model.problem import ArrangementProblem, Shape
 from arrange_up.model.world import WorldState
 
 BLOCK = Shape((geometry.box_polygon(1.0, 1.0),), box=(1.0, 1.0))
+
+DOMAINS = Path(__file__).parents[2] / "domains"
 
 
 def test_overlap_is_reported_by_the_later_object_with_its_area() -> None:
@@ -331,3 +336,29 @@ def test_a_shape_of_stacked_parts_lists_the_first_overlaps_and_says_there_are_mo
     errors = [d for d in diagnostics if d.severity == "error"]
     assert len(errors) == MAX_LISTED_OVERLAPS + 1
     assert errors[-1].message.startswith("part [14] and more parts overlap: only the first")
+
+
+def test_parts_that_overlap_at_their_goal_poses_are_a_warning_in_both_readers() -> None:
+    # The Z of the TZ mating moved 0.3 in left (its goal x in the T's frame 1.2 instead of
+    # 1.5): its lower column overlaps the T's stem by 0.3 x 2 in, its upper one the end of the
+    # T's bar by 0.3 x 1 in.
+    text = (DOMAINS / "tz-mating.yaml").read_text()
+    overlapping = text.replace("Z: [1.5, -0.4, 90]", "Z: [1.2, -0.4, 90]")
+    problem, diagnostics = check_problem_text(overlapping, "tz.yaml")
+    assert problem is not None  # a warning: a pose within the tolerance may separate them
+    assert goal_overlaps(problem) == [("T", "Z", pytest.approx(0.9))]
+    (warning,) = [str(d) for d in diagnostics]
+    assert "tz.yaml:" in warning and "goal.relative.poses.Z" in warning
+    assert "at their goal poses T and Z overlap by 0.9 square in" in warning
+    # The shipped goal only touches; the PDDL reader says the same of its twin.
+    assert goal_overlaps(check_problem_text(text, "tz.yaml")[0]) == []
+    pddl = (DOMAINS / "tz-mating.pddl").read_text()
+    moved = pddl.replace(
+        "(>= (rel-x Z T) 1.3) (<= (rel-x Z T) 1.7)", "(>= (rel-x Z T) 1.0) (<= (rel-x Z T) 1.4)"
+    )
+    problem, diagnostics = check_pddl_problem_text(moved, "tz.pddl")
+    assert problem is not None
+    (warning,) = [str(d) for d in diagnostics]
+    assert ": warning: " in warning and "T and Z overlap by 0.9 square in" in warning
+    _, clean = check_pddl_problem_text(pddl, "tz.pddl")
+    assert clean == []
