@@ -65,15 +65,14 @@ Distances:
 * **mating** (:mod:`arrange_up.planning.mating`), for a part whose relative goal holds it
   against the reference part ahead along the push: the goal-directed push stopped short by
   the goal tolerance, or by the part's spread relative to the reference where that is wider,
-  while the part still misses its goal interval across the push (beside
-  the notch, with room to slide into it from the side; with ``clearance_pushes``, which the
-  planner sets for a semantics of more than one particle: a single nominal state has no
-  spread to make room for, and a deterministic plan would end with the part at its goal
-  interval's edge), and under
-  the compliant controller, while the part misses its goal interval along the push, a seating
-  push to the goal coordinate plus the part's
-  :func:`~arrange_up.physics.stall.wall_overdrive` (pressed against the reference as against a
-  wall);
+  while the part still misses its goal interval across the push (brought beside its notch,
+  with room to slide into it from the side; only with ``clearance_pushes``, which the planner
+  sets for a semantics of more than one particle: a single nominal state has no spread to
+  make room for, and a deterministic plan would end with the part at its goal interval's
+  edge); and under the compliant controller, while the part misses its goal interval along
+  the push, a seating push to the goal coordinate plus the part's
+  :func:`~arrange_up.physics.stall.wall_overdrive` (pressed against the reference as against
+  a wall);
 * **a detour** round obstacles (:mod:`arrange_up.planning.obstacles`): where the straight push
   to the part's goal coordinate along one axis is blocked (an obstacle's box lies across the
   part's shadow, widened by ``obstacles.GAP``, before the goal), a push along the other axis,
@@ -816,13 +815,12 @@ class ActionGenerator:
     ) -> list[tuple[float, float | None]]:
         """The pushes of a part whose relative goal holds it against its mate ahead along the
         push (:mod:`arrange_up.planning.mating`), as ``(travel of the set point beyond the free
-        travel, travel of the part or None)``: the goal-directed push stopped short by the goal
-        tolerance, or by the part's spread relative to its mate where that is wider (a travel,
-        solved for like the goal-directed one) while the part still misses
-        its goal interval across the push, and, under the compliant
-        controller while the part's interval misses its goal interval along the push, the
-        seating push to the goal coordinate plus the part's wall overdrive (None: it stops at
-        the contact)."""
+        travel, travel of the part or None)``: while the part misses its goal interval across
+        the push, the goal-directed push stopped short by the goal tolerance, or by the part's
+        spread relative to its mate where that is wider (a travel, solved for like the
+        goal-directed one); and under the compliant controller, while the part misses its
+        goal interval along the push, the seating push to the goal coordinate plus the part's
+        wall overdrive (None: it stops at the contact)."""
         mate = belief.get(self.mates.reference)
         if mate is None or not self.mates.ahead(name, target, mate.center, axis, sign):
             return []
