@@ -202,6 +202,7 @@ class ActionGenerator:
         self.stall_per_area = stall_per_area(problem)
         self.areas = {spec.name: spec.shape.area for spec in problem.parts}
         self.wall_trains = self._wall_trains()
+        self._limits = (self._across_limits(0), self._across_limits(1))
         walls = set(problem.table.walls)
         held = {
             (part, 0 if DIRECTIONS[direction][0] else 1): True
@@ -593,23 +594,26 @@ class ActionGenerator:
         candidates = [min(max(centre, low), high)]
         candidates += [v for bounds in forbidden + ahead for v in bounds if low <= v <= high]
         candidates.sort(key=lambda v: abs(v - centre))
-        allowed = [v for v in candidates if all(not (lo < v < hi) for lo, hi in forbidden)]
-        if not allowed:
-            return []
-        for value in allowed:
-            if all(
-                not (touch_lo < value < touch_hi) or cover_lo <= value <= cover_hi
+        # The nearest allowed centre, and the nearest allowed one that clips no shadow ahead.
+        first = None
+        for value in candidates:
+            if any(lo < value < hi for lo, hi in forbidden):
+                continue
+            if first is None:
+                first = value
+            if not any(
+                touch_lo < value < touch_hi and not cover_lo <= value <= cover_hi
                 for touch_lo, touch_hi, cover_lo, cover_hi in ahead
             ):
-                return [allowed[0]] if abs(value - allowed[0]) <= 1e-6 else [allowed[0], value]
-        return [allowed[0]]
+                return [first] if abs(value - first) <= 1e-6 else [first, value]
+        return [] if first is None else [first]
 
     def _across_span(self, manip, interval, other: int, m_box) -> tuple[float, float]:
         """The range of centres across the push (along axis ``other``) at which the
         manipulator's long side covers the part's centre with 0.1 in to spare and its approach
         shadow (extents ``m_box``) keeps clear of the walls; empty (low > high) if none."""
         reach = 0.5 * manip.length - 0.1
-        low_lim, high_lim = self._across_limits(other)
+        low_lim, high_lim = self._limits[other]
         return (
             max(interval.center[other] - reach, low_lim - m_box[other]),
             min(interval.center[other] + reach, high_lim - m_box[other + 2]),
