@@ -407,8 +407,9 @@ def maximal_paths(graph: ContactGraph) -> list[tuple[object, ...]]:
         return []
     # A path contained in another is strictly shorter, so each is tested against the longer
     # paths kept so far only.
+    # (the walk lists each path once, and no two paths share a key: a total order)
     label = {node: repr(node) for node in graph.nodes}
-    paths = sorted(set(_paths_to_wall(graph)), key=lambda p: (-len(p), [label[n] for n in p]))
+    paths = sorted(_paths_to_wall(graph), key=lambda p: (-len(p), [label[n] for n in p]))
     kept: list[tuple[object, ...]] = []
     kept_sets: list[frozenset[object]] = []
     for path in paths:
@@ -430,7 +431,7 @@ def _paths_to_wall(graph: ContactGraph) -> list[tuple[object, ...]]:
     counted (for :data:`MAX_PATHS`, which counts every path), not kept. (The generic
     simple-path enumeration of networkx spent most of a CBST push's analysis on bookkeeping
     that this needs not.)"""
-    successors = {node: graph.successors(node) for node in graph.nodes}
+    successors = graph._ahead  # read in place: each node's successors in their order
     paths: list[tuple[object, ...]] = []
     found = 0
     stack: list[tuple[object, ...]] = [(ROBOT,)]
@@ -453,12 +454,13 @@ def _longest_train(graph: ContactGraph) -> int:
     """The number of objects on the longest ``ROBOT -> WALL`` path (the graph is acyclic: each
     node's longest train ahead is worked out once, deepest first)."""
     ahead: dict[object, int] = {}
+    successors = graph._ahead  # read in place: each node's successors in their order
     stack: list[tuple[object, bool]] = [(ROBOT, False)]
     while stack:
         node, done = stack.pop()
         if node in ahead:
             continue
-        objects = [n for n in graph.successors(node) if n is not WALL]
+        objects = [n for n in successors[node] if n is not WALL]
         if done:
             ahead[node] = max((1 + ahead[n] for n in objects), default=0)
             continue
