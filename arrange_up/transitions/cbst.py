@@ -145,6 +145,7 @@ class CBSTSemantics:
         self._predictions: dict[tuple[float, ...], np.ndarray | None] = {}
         self._nodes: dict[tuple[str, str, ObjectInterval], Node] = {}
         self._paddles: dict[Push, tuple[CanonicalFrame | None, Paddle | None]] = {}
+        self._scenes: dict[str, tuple[IntervalBelief, list[Node]]] = {}
         self._memo = PushMemo(OUTCOME_CACHE)
         self._outcomes: dict[tuple, tuple[PushStructure, str | tuple[dict, int]]] = {}
         self.reasons: Counter[str] = Counter()
@@ -231,7 +232,7 @@ class CBSTSemantics:
         if frame is None or paddle is None:
             return self._refuse("the push is not axis-aligned")
         d = self.block_size
-        nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
+        nodes = self._nodes_of(belief, frame)
         table = frame.table_box(problem.table.size)
         wall = table[2] if frame.wall_ahead in problem.table.walls else None
         obstacles = [frame.box_to(box) for box in self.checker.obstacle_boxes.values()]
@@ -389,6 +390,16 @@ class CBSTSemantics:
             )
             updates[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
         return None, updates, simulated
+
+    def _nodes_of(self, belief: IntervalBelief, frame: CanonicalFrame) -> list[Node]:
+        """The contact graph's nodes of ``belief``'s objects in ``frame``; the last belief's
+        are kept per direction, since a search evaluates one belief's pushes in a row."""
+        last = self._scenes.get(frame.direction)
+        if last is not None and last[0] is belief:
+            return last[1]
+        nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
+        self._scenes[frame.direction] = (belief, nodes)
+        return nodes
 
     def _node(self, frame: CanonicalFrame, name: str, interval: ObjectInterval) -> Node:
         """The contact graph's node of ``name`` at ``interval`` in ``frame``; remembered (up to
