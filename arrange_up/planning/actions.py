@@ -288,6 +288,7 @@ class ActionGenerator:
     def places(self, belief: IntervalBelief, only: str | None = None) -> list[Place]:
         """Place candidates of every goal part off the table (or of ``only``)."""
         on_table = self._shadows(belief)
+        boxes = None  # their shadow boxes, once a place is tested
         actions = []
         for spec in self.problem.parts:
             if spec.name in belief or (only is not None and spec.name != only):
@@ -299,7 +300,9 @@ class ActionGenerator:
             for dx, dy in self.offsets[spec.name]:
                 for theta in angles:
                     pose = (target[0] + dx, target[1] + dy, theta)
-                    if self._place_ok(spec.name, pose, self.place_unc, on_table):
+                    if boxes is None:
+                        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+                    if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
                         actions.append(Place(spec.name, _clean(pose)))
         return actions
 
@@ -324,9 +327,9 @@ class ActionGenerator:
         """The target's angle, then each ``planning.place_angles`` offset from it, once each."""
         return tuple(dict.fromkeys((target[2],) + tuple(target[2] + a for a in self.place_angles)))
 
-    def _place_ok(self, name, pose, half, on_table) -> bool:
+    def _place_ok(self, name, pose, half, on_table, boxes) -> bool:
         return self.checker.shadow_inside_table(name, pose, half) and self.checker.shadow_clear(
-            name, pose, half, on_table
+            name, pose, half, on_table, boxes
         )
 
     # -- push ------------------------------------------------------------------------------
@@ -490,7 +493,9 @@ class ActionGenerator:
                 )
             for across in centres:
                 pose = (along, across, theta) if axis == 0 else (across, along, theta)
-                if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
+                if self.checker.shadow_clear(
+                    manip.spec.name, pose, self.push_unc, on_table, [box for _, box in boxes]
+                ):
                     for d, travel in group:
                         push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
                         if self.stall_per_area and self.solve_distances and travel is not None:
