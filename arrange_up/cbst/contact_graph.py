@@ -316,9 +316,10 @@ def _contact_row(
         if other.name == source:
             continue
         # boxes_overlap(other.box, swept), written out: this loop is a CBST search's hottest
-        box = other.box
+        b0, b1, b2, b3 = other.box
         if not (
-            min(box[2], u1) - max(box[0], u0) > 0.0 and min(box[3], v1) - max(box[1], v0) > 0.0
+            (u1 if u1 < b2 else b2) - (u0 if u0 > b0 else b0) > 0.0
+            and (v1 if v1 < b3 else b3) - (v0 if v0 > b1 else b1) > 0.0
         ):
             continue
         try:
