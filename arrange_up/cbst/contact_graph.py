@@ -482,13 +482,20 @@ class PushMemo:
     nodes are the same is answered with the same :class:`PushStructure` object. Nodes are
     keyed by identity (the memo holds them, so no identity is reused while it is kept):
     callers that keep each belief's node (as the CBST semantics does) find their scenes.
-    Past ``limit`` entries a table starts again empty.
+    Past ``limit`` entries a table starts again empty; a copy (pickled) starts empty.
     """
 
     def __init__(self, limit: int = 100_000) -> None:
         self.limit = limit
         self._scenes: dict[tuple, tuple[tuple[Node, ...], dict[str, _Row]]] = {}
         self._structures: dict[tuple, tuple[tuple[Node, ...], PushStructure]] = {}
+
+    def __getstate__(self) -> dict[str, int]:
+        # the tables are keyed by identities, which mean nothing in another process
+        return {"limit": self.limit}
+
+    def __setstate__(self, state: dict[str, int]) -> None:
+        self.__init__(state["limit"])
 
     def rows(self, nodes: Sequence[Node], key: tuple) -> dict[str, _Row]:
         """The rows known so far of the scene of ``nodes`` (``key``: its wall and the rest)."""
