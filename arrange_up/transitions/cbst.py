@@ -107,6 +107,12 @@ TRAINED_PUSH_REFUSAL = "the push sends the paddle elsewhere than the model's tra
 TRAINED_PUSH_TOLERANCE = 1e-3
 
 
+#: What a predictable push does (:meth:`CBSTSemantics._outcome`): the reason it has no
+#: prediction after all (None if it has one), its members' new intervals and the number of
+#: model predictions it took.
+_Outcome = tuple[str | None, dict[str, ObjectInterval], int]
+
+
 def _r(value: float) -> float:
     return round(float(value), 6) + 0.0
 
@@ -145,9 +151,9 @@ class CBSTSemantics:
         self._predictions: dict[tuple[float, ...], np.ndarray | None] = {}
         self._nodes: dict[tuple[str, str, ObjectInterval], Node] = {}
         self._paddles: dict[Push, tuple[CanonicalFrame | None, Paddle | None]] = {}
-        self._scenes: dict[str, tuple[IntervalBelief, list[Node]]] = {}
+        self._last_nodes: dict[str, tuple[IntervalBelief, list[Node]]] = {}
         self._memo = PushMemo(OUTCOME_CACHE)
-        self._outcomes: dict[tuple, tuple[PushStructure, str | tuple[dict, int]]] = {}
+        self._outcomes: dict[tuple, tuple[PushStructure, _Outcome]] = {}
         self.reasons: Counter[str] = Counter()
         self.model = model_for(problem, model)
         card = self.model.card_
@@ -311,9 +317,7 @@ class CBSTSemantics:
         self._paddles[push] = (frame, paddle)
         return frame, paddle
 
-    def _outcome(
-        self, push, frame, paddle, structure, nodes, table, wall, spread
-    ) -> tuple[str | None, dict[str, ObjectInterval], int]:
+    def _outcome(self, push, frame, paddle, structure, nodes, table, wall, spread) -> _Outcome:
         """What a predictable push ``structure`` does: ``(refusal, updates, simulated)``, the
         reason it has no prediction (None if it has one), the members' new intervals and the
         number of model predictions it took (counted even when refused afterwards)."""
@@ -394,11 +398,11 @@ class CBSTSemantics:
     def _nodes_of(self, belief: IntervalBelief, frame: CanonicalFrame) -> list[Node]:
         """The contact graph's nodes of ``belief``'s objects in ``frame``; the last belief's
         are kept per direction, since a search evaluates one belief's pushes in a row."""
-        last = self._scenes.get(frame.direction)
+        last = self._last_nodes.get(frame.direction)
         if last is not None and last[0] is belief:
             return last[1]
         nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
-        self._scenes[frame.direction] = (belief, nodes)
+        self._last_nodes[frame.direction] = (belief, nodes)
         return nodes
 
     def _node(self, frame: CanonicalFrame, name: str, interval: ObjectInterval) -> Node:
