@@ -62,17 +62,20 @@ Design choices (the contracts the planner relies on)
 from __future__ import annotations
 
 import enum
+import gc
 import heapq
 import itertools
 import math
 import random
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Hashable, Iterable
+from collections.abc import Callable, Hashable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from typing import Any, Generic, Protocol, TypeVar
 
 __all__ = [
+    "COLLECTION_THRESHOLD",
     "DEAD_END_CACHE",
     "DOMINATED",
     "PROGRESS_INTERVAL",
@@ -96,6 +99,23 @@ PROGRESS_INTERVAL = 0.2
 #: seen first. Accepted states are kept anyway (duplicate detection needs them); dead ends are
 #: not, and caching every one kept each pruned state's belief alive for the whole search.
 DEAD_END_CACHE = 4096
+#: The garbage collector's youngest-generation threshold while a search runs (CPython's default
+#: is 700; a larger one set before is kept). Most of what a search allocates lives until it
+#: ends (accepted states, queued edges, the transitions' caches) and holds no cycles, so the
+#: collector's frequent passes, and the full ones they lead to, mostly walk live objects.
+COLLECTION_THRESHOLD = 20_000
+
+
+@contextmanager
+def _fewer_collections() -> Iterator[None]:
+    """Run the body with the youngest generation's threshold at least
+    :data:`COLLECTION_THRESHOLD`, then restore the thresholds as they were."""
+    before = gc.get_threshold()
+    gc.set_threshold(max(before[0], COLLECTION_THRESHOLD), *before[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*before)
 
 
 class SearchStatus(enum.StrEnum):
@@ -491,6 +511,10 @@ class _Search:
         return None
 
     def run(self, start: Any) -> SearchResult[Any, Any]:
+        with _fewer_collections():
+            return self._run(start)
+
+    def _run(self, start: Any) -> SearchResult[Any, Any]:
         self.t0 = self.last_progress = self.clock()
         if self.timeout is not None:
             self.deadline = self.t0 + self.timeout

@@ -331,17 +331,28 @@ class IntervalDominanceIndex:
     def __init__(self, tolerance: tuple[float, float, float] = (0.01, 0.01, 0.01)) -> None:
         self.tolerance = np.asarray(tolerance, dtype=float)
         self._buckets: dict[tuple[str, ...], _Bucket] = {}
+        self._tolerances: dict[int, np.ndarray] = {}  # the tolerance tiled, per width
+        self._last: tuple[ParticleBelief, np.ndarray, np.ndarray] | None = None
 
     def _bounds(self, belief: ParticleBelief) -> tuple[np.ndarray, np.ndarray]:
+        # The search asks whether a belief is dominated, then adds it: the last belief's
+        # bounds are kept for the second question.
+        last = self._last
+        if last is not None and last[0] is belief:
+            return last[1], last[2]
         poses = belief.poses
-        return poses.min(axis=0).ravel(), poses.max(axis=0).ravel()
+        low, high = poses.min(axis=0).ravel(), poses.max(axis=0).ravel()
+        self._last = (belief, low, high)
+        return low, high
 
     def dominated(self, belief: ParticleBelief, g: float) -> bool:
         bucket = self._buckets.get(belief.names())
         if bucket is None or bucket.size == 0:
             return False
         low, high = self._bounds(belief)
-        tol = np.tile(self.tolerance, len(low) // 3)
+        tol = self._tolerances.get(len(low))
+        if tol is None:
+            tol = self._tolerances[len(low)] = np.tile(self.tolerance, len(low) // 3)
         lows, highs = bucket.low[: bucket.size], bucket.high[: bucket.size]
         inside = np.all(lows >= low - tol, axis=1) & np.all(highs <= high + tol, axis=1)
         return bool(inside.any())

@@ -24,7 +24,7 @@ from typing import Any
 from arrange_up.cbst.model import (
     DEFAULT_MODEL,
     SHIPPED_MODELS,
-    CBSTRegressor,
+    TrainedModel,
     load_model,
     shipped_name,
 )
@@ -120,7 +120,7 @@ def describe(controller: Controller, gains: Mapping[str, float] | None = None) -
 
 def model_for(
     problem: ArrangementProblem, name_or_path: str | Path = DEFAULT_MODEL
-) -> CBSTRegressor:
+) -> TrainedModel:
     """The model ``name_or_path`` (a shipped name, ``"default"`` for the shipped model of the
     problem's controller, or a card path), checked to have been trained under the problem's
     controller.

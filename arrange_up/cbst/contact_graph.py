@@ -49,6 +49,9 @@ wall. The push is predicted when
 Anything else answers "no prediction" with a reason. A push whose paddle sweep (its commanded
 travel) touches no object leaves the belief unchanged.
 
+A :class:`PushMemo` passed to :func:`analyse_push` remembers the graph's rows per scene and
+the structure per push and reached nodes, for the many pushes of a search.
+
 Paths of equal length may share objects (two rows pushed together, with grazing contacts
 between the rows): the depths make the result well defined, and the caller predicts each
 object from each of its certain (previous, next) neighbour pairs and keeps the largest
@@ -75,6 +78,7 @@ __all__ = [
     "Member",
     "Node",
     "Paddle",
+    "PushMemo",
     "PushStructure",
     "analyse_push",
     "make_contact_graph",
@@ -193,8 +197,6 @@ class PushStructure:
 
     kind: str
     reason: str = ""
-    graph: ContactGraph | None = None
-    paths: tuple[tuple[object, ...], ...] = ()
     members: tuple[Member, ...] = ()
     length: int = 0
     untouched: frozenset[str] = field(default_factory=frozenset)
@@ -287,6 +289,101 @@ def _shadow_overlap(a: Node, b: Node) -> float:
 
 
 # -- MAKECG --------------------------------------------------------------------------------------
+#: A row of the contact graph: the edges out of one node, ``(i, certain)`` to the scene's
+#: ``i``-th node in the scene's order, ended by a reason (a string) when meeting the next node
+#: (or an obstacle) makes the push unpredictable once the row's node is reached. (Indices, not
+#: nodes: rows of numbers and flags are left alone by the garbage collector.)
+_Row = tuple[object, ...]
+
+
+def _contact_row(
+    current: Node | Paddle,
+    nodes: Sequence[Node],
+    end: float,
+    block_size: float,
+    obstacles: Sequence[Box],
+) -> _Row:
+    """The edges out of ``current`` to the ``nodes`` whose box overlaps ``current``'s box
+    swept up to ``end`` (see :data:`_Row`)."""
+    source = ROBOT if isinstance(current, Paddle) else current.name
+    swept = _swept(current.box, end)
+    for box in obstacles:
+        if boxes_overlap(box, swept):
+            return ("an obstacle lies in the path of the push",)
+    u0, v0, u1, v1 = swept
+    row: list[object] = []
+    for i, other in enumerate(nodes):
+        if other.name == source:
+            continue
+        # boxes_overlap(other.box, swept), written out: this loop is a CBST search's hottest
+        b0, b1, b2, b3 = other.box
+        if not (
+            (u1 if u1 < b2 else b2) - (u0 if u0 > b0 else b0) > 0.0
+            and (v1 if v1 < b3 else b3) - (v0 if v0 > b1 else b1) > 0.0
+        ):
+            continue
+        try:
+            certain = _contact(current, other, block_size)
+        except Unpredictable as why:
+            return (*row, str(why))
+        if certain is None:
+            continue
+        if not other.block:
+            return (*row, f"{other.name!r} may be pushed and is not a block")
+        row.append((i, certain))
+    return tuple(row)
+
+
+def _build(
+    paddle: Paddle,
+    nodes: Sequence[Node],
+    wall: float | None,
+    block_size: float,
+    obstacles: Sequence[Box],
+    rows: dict[str, _Row] | None,
+) -> tuple[ContactGraph, list[Node]]:
+    """MAKECG: the graph and the reached nodes in the order they were met. ``rows``, the
+    objects' rows (:func:`_contact_row`) of this scene known so far, is read and filled."""
+    end = wall if wall is not None else math.inf
+    graph = ContactGraph()
+    graph.add_node(ROBOT)
+    if wall is not None:
+        graph.add_node(WALL)
+    # the graph's own tables, filled here directly: this is the hot loop of a CBST search
+    ahead, behind = graph._ahead, graph._behind
+    agenda: list[Node | Paddle] = [paddle]
+    reached: list[Node] = []
+    while agenda:
+        current = agenda.pop()
+        if isinstance(current, Paddle):
+            source: object = ROBOT
+            row = _contact_row(current, nodes, end, block_size, obstacles)
+        else:
+            source = current.name
+            row = rows.get(source) if rows is not None else None
+            if row is None:
+                row = _contact_row(current, nodes, end, block_size, obstacles)
+                if rows is not None:
+                    rows[source] = row
+        out = ahead[source]
+        for entry in row:
+            if isinstance(entry, str):
+                raise Unpredictable(entry)
+            i, certain = entry
+            other = nodes[i]
+            name = other.name
+            if name not in ahead:
+                reached.append(other)
+                agenda.append(other)
+                ahead[name], behind[name] = {}, {}
+            out[name] = certain
+            behind[name][source] = certain
+        if wall is not None:
+            out[WALL] = True
+            behind[WALL][source] = True
+    return graph, reached
+
+
 def make_contact_graph(
     paddle: Paddle,
     nodes: Sequence[Node],
@@ -301,49 +398,7 @@ def make_contact_graph(
     Raises :class:`Unpredictable` for an obstacle in a swept volume, an undecided order,
     or a reached object that is not a block.
     """
-    end = wall if wall is not None else math.inf
-    graph = ContactGraph()
-    graph.add_node(ROBOT)
-    if wall is not None:
-        graph.add_node(WALL)
-    # the graph's own tables, filled here directly: this is the hot loop of a CBST search
-    ahead, behind = graph._ahead, graph._behind
-    agenda: list[Node | Paddle] = [paddle]
-    seen: set[str] = set()
-    while agenda:
-        current = agenda.pop()
-        source = ROBOT if isinstance(current, Paddle) else current.name
-        swept = _swept(current.box, end)
-        for box in obstacles:
-            if boxes_overlap(box, swept):
-                raise Unpredictable("an obstacle lies in the path of the push")
-        u0, v0, u1, v1 = swept
-        for other in nodes:
-            if other.name == source:
-                continue
-            # boxes_overlap(other.box, swept), written out: this loop is a CBST search's
-            # hottest
-            box = other.box
-            if not (
-                min(box[2], u1) - max(box[0], u0) > 0.0 and min(box[3], v1) - max(box[1], v0) > 0.0
-            ):
-                continue
-            certain = _contact(current, other, block_size)
-            if certain is None:
-                continue
-            if not other.block:
-                raise Unpredictable(f"{other.name!r} may be pushed and is not a block")
-            name = other.name
-            if name not in seen:
-                seen.add(name)
-                agenda.append(other)
-                ahead[name], behind[name] = {}, {}
-            ahead[source][name] = certain
-            behind[name][source] = certain
-        if wall is not None:
-            ahead[source][WALL] = True
-            behind[WALL][source] = True
-    return graph
+    return _build(paddle, nodes, wall, block_size, obstacles, None)[0]
 
 
 def maximal_paths(graph: ContactGraph) -> list[tuple[object, ...]]:
@@ -353,8 +408,9 @@ def maximal_paths(graph: ContactGraph) -> list[tuple[object, ...]]:
         return []
     # A path contained in another is strictly shorter, so each is tested against the longer
     # paths kept so far only.
+    # (the walk lists each path once, and no two paths share a key: a total order)
     label = {node: repr(node) for node in graph.nodes}
-    paths = sorted(set(_paths_to_wall(graph)), key=lambda p: (-len(p), [label[n] for n in p]))
+    paths = sorted(_paths_to_wall(graph), key=lambda p: (-len(p), [label[n] for n in p]))
     kept: list[tuple[object, ...]] = []
     kept_sets: list[frozenset[object]] = []
     for path in paths:
@@ -376,7 +432,7 @@ def _paths_to_wall(graph: ContactGraph) -> list[tuple[object, ...]]:
     counted (for :data:`MAX_PATHS`, which counts every path), not kept. (The generic
     simple-path enumeration of networkx spent most of a CBST push's analysis on bookkeeping
     that this needs not.)"""
-    successors = {node: graph.successors(node) for node in graph.nodes}
+    successors = graph._ahead  # read in place: each node's successors in their order
     paths: list[tuple[object, ...]] = []
     found = 0
     stack: list[tuple[object, ...]] = [(ROBOT,)]
@@ -399,12 +455,13 @@ def _longest_train(graph: ContactGraph) -> int:
     """The number of objects on the longest ``ROBOT -> WALL`` path (the graph is acyclic: each
     node's longest train ahead is worked out once, deepest first)."""
     ahead: dict[object, int] = {}
+    successors = graph._ahead  # read in place: each node's successors in their order
     stack: list[tuple[object, bool]] = [(ROBOT, False)]
     while stack:
         node, done = stack.pop()
         if node in ahead:
             continue
-        objects = [n for n in graph.successors(node) if n is not WALL]
+        objects = [n for n in successors[node] if n is not WALL]
         if done:
             ahead[node] = max((1 + ahead[n] for n in objects), default=0)
             continue
@@ -414,6 +471,54 @@ def _longest_train(graph: ContactGraph) -> int:
 
 
 # -- PUSHTRANS (structure) -----------------------------------------------------------------------
+class PushMemo:
+    """What :func:`analyse_push` worked out for one search, remembered for its next pushes.
+
+    A search meets the same objects' beliefs in many beliefs, and one belief's pushes share
+    its scene. So this remembers, per scene (the nodes, the wall, the obstacles), the rows of
+    the contact graph (each object's edges), which all pushes in that scene's direction
+    share; and per push (the paddle, the wall, the obstacles and the nodes it reached), the
+    structure, which depends on nothing else. A push met again in another scene whose reached
+    nodes are the same is answered with the same :class:`PushStructure` object. Nodes are
+    keyed by identity (the memo holds them, so no identity is reused while it is kept):
+    callers that keep each belief's node (as the CBST semantics does) find their scenes.
+    Past ``limit`` entries a table starts again empty; a copy (pickled) starts empty.
+    """
+
+    def __init__(self, limit: int = 100_000) -> None:
+        self.limit = limit
+        self._scenes: dict[tuple, tuple[tuple[Node, ...], dict[str, _Row]]] = {}
+        self._structures: dict[tuple, tuple[tuple[Node, ...], PushStructure]] = {}
+
+    def __getstate__(self) -> dict[str, int]:
+        # the tables are keyed by identities, which mean nothing in another process
+        return {"limit": self.limit}
+
+    def __setstate__(self, state: dict[str, int]) -> None:
+        self.__init__(state["limit"])
+
+    def rows(self, nodes: Sequence[Node], key: tuple) -> dict[str, _Row]:
+        """The rows known so far of the scene of ``nodes`` (``key``: its wall and the rest)."""
+        scene = (*key, *map(id, nodes))
+        known = self._scenes.get(scene)
+        if known is None:
+            if len(self._scenes) >= self.limit:
+                self._scenes.clear()
+            known = self._scenes[scene] = (tuple(nodes), {})
+        return known[1]
+
+    def structure(self, reached: Sequence[Node], key: tuple, analyse) -> PushStructure:
+        """The structure of the push ``key`` (its paddle, wall and the rest) that reached
+        ``reached``: remembered, or ``analyse()``'s."""
+        push = (*key, *map(id, reached))
+        known = self._structures.get(push)
+        if known is None:
+            if len(self._structures) >= self.limit:
+                self._structures.clear()
+            known = self._structures[push] = (tuple(reached), analyse())
+        return known[1]
+
+
 def analyse_push(
     paddle: Paddle,
     nodes: Sequence[Node],
@@ -421,21 +526,34 @@ def analyse_push(
     wall: float | None,
     block_size: float,
     obstacles: Sequence[Box] = (),
+    memo: PushMemo | None = None,
 ) -> PushStructure:
     """Decide what a push does (see the module docstring): unchanged, the trains to predict,
-    or no prediction with a reason."""
+    or no prediction with a reason. With ``memo``, what it remembers is used and added to
+    (the same answers as without)."""
     reach = paddle.reach_box
     if not any(boxes_overlap(node.box, reach) for node in nodes):
         return PushStructure("unchanged")
+    scene = (wall, block_size, tuple(obstacles))
     try:
-        return _analyse(paddle, nodes, wall, block_size, obstacles)
+        rows = memo.rows(nodes, scene) if memo is not None else None
+        graph, reached = _build(paddle, nodes, wall, block_size, obstacles, rows)
     except Unpredictable as why:
         return PushStructure("none", reason=str(why))
 
+    def analyse() -> PushStructure:
+        try:
+            return _analyse(graph, paddle, reached, wall, block_size)
+        except Unpredictable as why:
+            return PushStructure("none", reason=str(why))
 
-def _analyse(paddle, nodes, wall, block_size, obstacles) -> PushStructure:
-    graph = make_contact_graph(paddle, nodes, wall=wall, block_size=block_size, obstacles=obstacles)
-    reached = [n for n in graph.nodes if n is not ROBOT and n is not WALL]
+    if memo is None:
+        return analyse()
+    return memo.structure(reached, (paddle, *scene), analyse)
+
+
+def _analyse(graph, paddle, reached, wall, block_size) -> PushStructure:
+    """PUSHTRANS's structure from the contact graph and its ``reached`` nodes."""
     if wall is None:
         raise Unpredictable("no wall ahead: the pushed objects are not stopped")
     # The reach test needs only the longest train, found without listing the paths: most
@@ -457,7 +575,7 @@ def _analyse(paddle, nodes, wall, block_size, obstacles) -> PushStructure:
             if len(objects) == length:
                 on_long.add(name)
     d = block_size
-    by_name = {node.name: node for node in nodes}
+    by_name = {node.name: node for node in reached}
     closest = wall - length * d + paddle.tilt_spread + REACH_MARGIN
     for path in paths:
         objects = path[1:-1]
@@ -503,11 +621,9 @@ def _analyse(paddle, nodes, wall, block_size, obstacles) -> PushStructure:
             raise Unpredictable(f"{name!r} may or may not be pushed (no certain contact behind)")
         graze = max(_shadow_overlap(by_name[g], node) for g in grazers)
         members.append(Member(name, k, (), nexts, grazers, graze))
-    untouched = frozenset(n for n in reached if n not in on_long)
+    untouched = frozenset(node.name for node in reached if node.name not in on_long)
     return PushStructure(
         "predict",
-        graph=graph,
-        paths=tuple(paths),
         members=tuple(members),
         length=length,
         untouched=untouched,

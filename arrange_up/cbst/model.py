@@ -1,17 +1,19 @@
 """The learned PREDICT of CBST: a multi-output random forest (thesis §3.2).
 
-* :class:`CBSTRegressor` is a scikit-learn estimator (hyperparameters only in ``__init__``,
-  ``fit`` validates and returns ``self``, learned state ends in ``_``) wrapping a
-  ``RandomForestRegressor``. After ``fit`` it predicts through a :class:`FastForest` copy of
-  the trees, which gives the same numbers as the forest (to ~1e-15) many times faster.
+* :class:`~arrange_up.cbst.estimator.CBSTRegressor` (its own module, which imports
+  scikit-learn) is the estimator that training fits; ``CBSTRegressor`` is also found here.
+* :class:`TrainedModel` is a fitted model as stored: the trees as a :class:`FastForest` and
+  the residual pairs. :func:`load_model` returns one, so that planning never imports
+  scikit-learn (about a second, a tenth of a CBST blocks-9 search).
 * :func:`tune` grid-searches the hyperparameters with 8-fold cross-validation, as the thesis
   did, and refits; :func:`cross_validate` gives per-target out-of-fold RMSE and R^2. Rows
   of one example (the blocks of one belief) never straddle a fold (``GroupKFold``). The
   unbiased figure is the score on a fresh test set generated with another seed
   (:func:`train_cbst`; :func:`rescore_model` measures both again for a saved model).
 * :func:`save_model` writes ``NAME.npz`` (the trees' arrays, numbers only) and ``NAME.json``
-  (the model card); :func:`load_model` reads them back with ``allow_pickle=False`` after
-  checking the arrays' SHA-256 against the card. No model file is ever pickled.
+  (the model card); :func:`load_model` reads them back (a :class:`TrainedModel`) with
+  ``allow_pickle=False`` after checking the arrays' SHA-256 against the card. No model file
+  is ever pickled.
 * :func:`train_cbst` is the whole pipeline behind ``arrange-up train-cbst``: generate (or
   resume) the data and a fresh test set under a given controller, tune, score, save.
 
@@ -31,12 +33,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import replace
 from functools import lru_cache, partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sklearn
-from sklearn.base import BaseEstimator, MultiOutputMixin, RegressorMixin
-from sklearn.utils.validation import check_is_fitted, validate_data
 
 from arrange_up import __version__
 from arrange_up.cbst.data import (
@@ -59,6 +58,9 @@ from arrange_up.io.resources import shipped_dir
 from arrange_up.model.problem import DEFAULT_CONTROLLER, Controller, ControllerKind
 from arrange_up.parallel import available_cores
 
+if TYPE_CHECKING:
+    from arrange_up.cbst.estimator import CBSTRegressor
+
 __all__ = [
     "CARD_FORMAT",
     "DEFAULT_GRID",
@@ -66,9 +68,12 @@ __all__ = [
     "SHIPPED_MODELS",
     "DY_RESIDUAL",
     "CBSTRegressor",
+    "TrainedModel",
+    "check_residual",
     "cross_validate",
     "load_model",
     "model_dir",
+    "predict_rows",
     "rescore_model",
     "save_model",
     "shipped_name",
@@ -77,6 +82,16 @@ __all__ = [
 ]
 
 CARD_FORMAT = "arrange-up-cbst-model/1"
+
+
+def __getattr__(name: str) -> Any:
+    # The estimator is found here too, imported (with scikit-learn) only by those who use it.
+    if name == "CBSTRegressor":
+        from arrange_up.cbst.estimator import CBSTRegressor
+
+        return CBSTRegressor
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 #: The name of the shipped model for the problem's controller.
 DEFAULT_MODEL = "default"
@@ -104,127 +119,58 @@ ProgressCallback = Callable[[str, int, int], None]
 
 
 # ----------------------------------------------------------------------------------------------
-# The estimator
+# The stored model
 # ----------------------------------------------------------------------------------------------
-class CBSTRegressor(MultiOutputMixin, RegressorMixin, BaseEstimator):
-    """Multi-output random-forest regressor with a fast flat-array predictor.
+def check_residual(residual, n_features: int, n_outputs: int) -> tuple[tuple[int, int], ...]:
+    """``residual``'s ``(output, feature)`` pairs as ints; ``ValueError`` for one out of range."""
+    pairs = tuple((int(o), int(f)) for o, f in (residual or ()))
+    for o, f in pairs:
+        if not (0 <= o < n_outputs and 0 <= f < n_features):
+            raise ValueError(
+                f"residual pair {(o, f)} out of range for {n_outputs} outputs and "
+                f"{n_features} features"
+            )
+    return pairs
 
-    Parameters are those of :class:`sklearn.ensemble.RandomForestRegressor` that the grid
-    search tunes or that make a fit reproducible, plus ``residual``: pairs
-    ``(output, feature)`` for which the forest learns ``y[:, output] - X[:, feature]`` and
-    ``predict`` adds the feature back. The uncertainty across a push is mostly the prior
-    uncertainty carried over plus a drift (``dy ≈ dy_c + drift``), a linear carry-over that
-    a forest reproduces poorly near the edge of the data; learning the drift removes that
-    bias without changing the targets.
 
-    Attributes
-    ----------
-    forest_ : FastForest
-        The fitted trees as flat arrays; ``predict`` uses it.
-    estimator_ : RandomForestRegressor
-        The fitted forest (absent on a model read by :func:`load_model`).
-    n_features_in_ : int
-    n_outputs_ : int
+def predict_rows(
+    forest: FastForest, residual: tuple[tuple[int, int], ...], X: np.ndarray
+) -> np.ndarray:
+    """The forest's predictions for trusted float rows ``X`` of the right width, with each
+    residual pair's feature added back to its output; always ``(rows, outputs)``."""
+    out = forest.predict(X)
+    for o, f in residual:
+        out[:, o] += X[:, f]
+    return out
+
+
+class TrainedModel:
+    """A fitted CBST model as :func:`load_model` reads it: the trees as a :class:`FastForest`
+    (``forest_``) and the residual pairs (``residual_``, see
+    :class:`~arrange_up.cbst.estimator.CBSTRegressor`), predicting without scikit-learn
+    (importing it would cost every planning run about a second). :func:`load_model` attaches
+    ``card_``, ``card_path_`` and ``domain_``.
     """
 
-    def __init__(
-        self,
-        n_estimators: int = 100,
-        max_depth: int | None = None,
-        min_samples_leaf: int = 1,
-        max_features: float | str | None = 1.0,
-        bootstrap: bool = True,
-        residual: tuple[tuple[int, int], ...] | None = None,
-        random_state: int | None = None,
-        n_jobs: int | None = None,
-    ) -> None:
-        self.n_estimators = n_estimators
-        self.max_depth = max_depth
-        self.min_samples_leaf = min_samples_leaf
-        self.max_features = max_features
-        self.bootstrap = bootstrap
-        self.residual = residual
-        self.random_state = random_state
-        self.n_jobs = n_jobs
-
-    def fit(self, X, y) -> CBSTRegressor:
-        from sklearn.ensemble import RandomForestRegressor
-
-        X, y = validate_data(self, X, y, multi_output=True, y_numeric=True)
-        y = np.array(y, dtype=np.float64)
-        self._single_output = y.ndim == 1
-        self.residual_ = self._check_residual(X.shape[1], 1 if y.ndim == 1 else y.shape[1])
-        if self.residual_:
-            y = y.reshape(len(y), -1)
-            for out, feat in self.residual_:
-                y[:, out] -= X[:, feat]
-            if self._single_output:
-                y = y[:, 0]
-        forest = RandomForestRegressor(
-            n_estimators=self.n_estimators,
-            max_depth=self.max_depth,
-            min_samples_leaf=self.min_samples_leaf,
-            max_features=self.max_features,
-            bootstrap=self.bootstrap,
-            random_state=self.random_state,
-            n_jobs=self.n_jobs,
-        )
-        forest.fit(X, y)
-        self.estimator_ = forest
-        self.forest_ = FastForest.from_sklearn(forest)
-        self.n_outputs_ = 1 if self._single_output else y.shape[1]
-        return self
+    def __init__(self, forest: FastForest, residual=None) -> None:
+        self.forest_ = forest
+        self.residual_ = check_residual(residual, forest.n_features, forest.n_outputs)
+        self.n_features_in_ = forest.n_features
+        self.n_outputs_ = forest.n_outputs
 
     def predict(self, X) -> np.ndarray:
-        check_is_fitted(self, "forest_")
-        X = validate_data(self, X, reset=False)
-        out = self.predict_rows(X)
-        return out[:, 0] if self._single_output else out
+        """``(rows, outputs)`` predictions of the rows ``X``; ``ValueError`` unless ``X`` is
+        a finite 2-D array of ``n_features_in_`` columns."""
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim != 2 or X.shape[1] != self.n_features_in_ or not np.isfinite(X).all():
+            raise ValueError(
+                f"expected finite rows of {self.n_features_in_} features, got shape {X.shape}"
+            )
+        return self.predict_rows(X)
 
     def predict_rows(self, X: np.ndarray) -> np.ndarray:
-        """``predict`` without input validation, for trusted float arrays of the right width
-        (the semantics' hot path); always ``(rows, outputs)``."""
-        out = self.forest_.predict(X)
-        for o, f in self.residual_:
-            out[:, o] += X[:, f]
-        return out
-
-    def _check_residual(self, n_features: int, n_outputs: int) -> tuple[tuple[int, int], ...]:
-        pairs = tuple((int(o), int(f)) for o, f in (self.residual or ()))
-        for o, f in pairs:
-            if not (0 <= o < n_outputs and 0 <= f < n_features):
-                raise ValueError(
-                    f"residual pair {(o, f)} out of range for {n_outputs} outputs and "
-                    f"{n_features} features"
-                )
-        return pairs
-
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.target_tags.multi_output = True
-        tags.target_tags.single_output = True
-        return tags
-
-    # -- built from stored arrays ----------------------------------------------------------
-    @classmethod
-    def from_forest(
-        cls, forest: FastForest, params: Mapping[str, Any] | None = None
-    ) -> CBSTRegressor:
-        """A fitted regressor around stored arrays (no ``estimator_``)."""
-        kept = {k: v for k, v in (params or {}).items() if k in cls._param_names()}
-        if kept.get("residual") is not None:  # JSON lists -> tuples
-            kept["residual"] = tuple(tuple(int(v) for v in pair) for pair in kept["residual"])
-        model = cls(**kept)
-        model.residual_ = model._check_residual(forest.n_features, forest.n_outputs)
-        model.forest_ = forest
-        model.n_features_in_ = forest.n_features
-        model.n_outputs_ = forest.n_outputs
-        model._single_output = False
-        return model
-
-    @classmethod
-    def _param_names(cls) -> list[str]:
-        return cls._get_param_names()
+        """:meth:`predict` without input validation (the semantics' hot path)."""
+        return predict_rows(self.forest_, self.residual_, X)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -258,6 +204,8 @@ def cross_validate(
     (``GroupKFold`` on ``groups``: the rows of one example never straddle a fold)."""
     from joblib import parallel_config
     from sklearn.model_selection import GroupKFold, cross_val_predict
+
+    from arrange_up.cbst.estimator import CBSTRegressor
 
     # Threads, not joblib's loky processes: the data generation leaves the process's shared
     # loky executor (arrange_up.parallel) running, and joblib.Parallel cannot take that one
@@ -298,6 +246,8 @@ def tune(
     from joblib import parallel_config
     from sklearn.model_selection import GridSearchCV, GroupKFold
 
+    from arrange_up.cbst.estimator import CBSTRegressor
+
     grid = dict(param_grid or DEFAULT_GRID)
     base = CBSTRegressor(n_estimators=n_estimators, random_state=seed, n_jobs=1)
     folds = GroupKFold(n_splits=cv)
@@ -337,11 +287,13 @@ def model_dir() -> Path:
 
 
 def save_model(
-    model: CBSTRegressor, card: Mapping[str, Any], directory: str | Path, name: str
+    model: CBSTRegressor | TrainedModel, card: Mapping[str, Any], directory: str | Path, name: str
 ) -> Path:
     """Write ``NAME.npz`` (arrays only) and ``NAME.json`` (the card, with the arrays'
-    SHA-256 and size added) into ``directory``; returns the card's path."""
-    check_is_fitted(model, "forest_")
+    SHA-256 and size added) into ``directory``; returns the card's path. ``ValueError`` for a
+    model not fitted."""
+    if getattr(model, "forest_", None) is None:
+        raise ValueError(f"{type(model).__name__} is not fitted: it has no trees to save")
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     arrays_path = directory / f"{name}.npz"
@@ -394,8 +346,8 @@ def _resolve(name_or_path: str | Path) -> Path:
 
 def load_model(
     name_or_path: str | Path = DEFAULT_MODEL, controller: Controller | None = None
-) -> CBSTRegressor:
-    """A fitted :class:`CBSTRegressor` from a shipped name (``"default"``: the shipped model of
+) -> TrainedModel:
+    """A fitted :class:`TrainedModel` from a shipped name (``"default"``: the shipped model of
     ``controller``, see :func:`shipped_name`) or a card/arrays path. The card is attached as
     ``model.card_``, its path as ``model.card_path_`` and the validity domain as
     ``model.domain_``. Cached per resolved path. Whether the model suits a problem's
@@ -431,7 +383,7 @@ _ARRAY_KINDS = {
 
 
 @lru_cache(maxsize=8)
-def _load_cached(card_path: str, _mtime: int, _size: int) -> CBSTRegressor:
+def _load_cached(card_path: str, _mtime: int, _size: int) -> TrainedModel:
     path = Path(card_path)
     try:
         card = json.loads(path.read_text(encoding="utf-8"))
@@ -443,8 +395,8 @@ def _load_cached(card_path: str, _mtime: int, _size: int) -> CBSTRegressor:
     try:
         arrays_path, arrays = _read_arrays(path, card)
         forest = _checked_forest(arrays, card, arrays_path)
-        params = card.get("model", {}).get("params")
-        model = CBSTRegressor.from_forest(forest, params)
+        params = card.get("model", {}).get("params") or {}
+        model = TrainedModel(forest, params.get("residual"))
         model.card_ = card
         model.card_path_ = path
         model.domain_ = _checked_card_numbers(card)
@@ -811,6 +763,8 @@ def train_cbst(
     if progress is not None:
         progress("fit", 1, 1)
     depths = _row_depths(dataset.X, dataset.groups)
+    import sklearn
+
     # Lazy: choice imports this module (it loads the models it checks).
     from arrange_up.cbst.choice import controller_record
 

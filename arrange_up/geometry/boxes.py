@@ -56,7 +56,13 @@ def boxes_overlap(a: Box, b: Box, tol: float = 0.0) -> bool:
     Boxes that only touch (shared edge or corner) do not overlap for ``tol >= 0``; a negative
     ``tol`` makes near-misses count as overlapping (a safety margin).
     """
-    return (min(a[2], b[2]) - max(a[0], b[0]) > tol) and (min(a[3], b[3]) - max(a[1], b[1]) > tol)
+    # min and max written out (the same values: the first argument unless the second is
+    # smaller, resp. larger): this is one of a search's most frequent calls
+    a0, a1, a2, a3 = a
+    b0, b1, b2, b3 = b
+    return ((b2 if b2 < a2 else a2) - (b0 if b0 > a0 else a0) > tol) and (
+        (b3 if b3 < a3 else a3) - (b1 if b1 > a1 else a1) > tol
+    )
 
 
 def box_row(

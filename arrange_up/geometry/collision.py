@@ -18,7 +18,7 @@ import numpy as np
 from shapely.geometry import box as shapely_box
 
 from arrange_up.geometry import shapes as geometry
-from arrange_up.geometry.boxes import box_corners, wall_boxes
+from arrange_up.geometry.boxes import Box, box_corners, wall_boxes
 from arrange_up.geometry.polygons import convex_penetration
 from arrange_up.geometry.se2 import transform_points
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, Pose
@@ -84,10 +84,12 @@ class CollisionChecker:
         """True if the belief shadows of two objects may overlap (boxes, then hulls)."""
         return self._overlap(self.shadow_box(*a), a[0], tuple(a[1]), tuple(a[2]), b)
 
-    def _overlap(self, box, name: str, pose: Pose, half: HalfWidths, other) -> bool:
+    def _overlap(self, box, name: str, pose: Pose, half: HalfWidths, other, other_box=None) -> bool:
         """:meth:`shadows_overlap` of ``(name, pose, half)``, whose shadow box is ``box``
-        (tuples), and ``other``."""
-        if not geometry.boxes_overlap(box, self.shadow_box(*other), -CLEARANCE):
+        (tuples), and ``other``, whose shadow box is ``other_box`` if given."""
+        if other_box is None:
+            other_box = self.shadow_box(*other)
+        if not geometry.boxes_overlap(box, other_box, -CLEARANCE):
             return False
         return self._hulls_meet(name, pose, half, other[0], tuple(other[1]), tuple(other[2]))
 
@@ -126,13 +128,21 @@ class CollisionChecker:
         pose: Pose,
         half: HalfWidths,
         others: Iterable[tuple[str, Pose, HalfWidths]],
+        boxes: Iterable[Box] | None = None,
     ) -> bool:
-        """The place precondition: ``name``'s shadow touches no other shadow, wall or obstacle."""
+        """The place precondition: ``name``'s shadow touches no other shadow, wall or obstacle.
+        ``boxes``: the others' shadow boxes in their order, when the caller has them (an
+        action generator tests many poses against one belief's shadows)."""
         pose, half = tuple(pose), tuple(half)
         if self._hits_fixed(name, pose, half):
             return False
         box = self._shadow_box(name, pose, half)
-        return not any(self._overlap(box, name, pose, half, other) for other in others)
+        if boxes is None:
+            return not any(self._overlap(box, name, pose, half, other) for other in others)
+        return not any(
+            self._overlap(box, name, pose, half, other, other_box)
+            for other, other_box in zip(others, boxes, strict=True)
+        )
 
 
 def _box_geom(box):

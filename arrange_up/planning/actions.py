@@ -225,6 +225,7 @@ class ActionGenerator:
         self.stall_per_area = stall_per_area(problem)
         self.areas = {spec.name: spec.shape.area for spec in problem.parts}
         self.wall_trains = self._wall_trains()
+        self._limits = (self._across_limits(0), self._across_limits(1))
         walls = set(problem.table.walls)
         held = {
             (part, 0 if DIRECTIONS[direction][0] else 1): True
@@ -311,6 +312,7 @@ class ActionGenerator:
     def places(self, belief: IntervalBelief, only: str | None = None) -> list[Place]:
         """Place candidates of every goal part off the table (or of ``only``)."""
         on_table = self._shadows(belief)
+        boxes = None  # their shadow boxes, once a place is tested
         actions = []
         for spec in self.problem.parts:
             if spec.name in belief or (only is not None and spec.name != only):
@@ -322,7 +324,9 @@ class ActionGenerator:
             for dx, dy in self.offsets[spec.name]:
                 for theta in angles:
                     pose = (target[0] + dx, target[1] + dy, theta)
-                    if self._place_ok(spec.name, pose, self.place_unc, on_table):
+                    if boxes is None:
+                        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+                    if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
                         actions.append(Place(spec.name, _clean(pose)))
         return actions
 
@@ -347,9 +351,9 @@ class ActionGenerator:
         """The target's angle, then each ``planning.place_angles`` offset from it, once each."""
         return tuple(dict.fromkeys((target[2],) + tuple(target[2] + a for a in self.place_angles)))
 
-    def _place_ok(self, name, pose, half, on_table) -> bool:
+    def _place_ok(self, name, pose, half, on_table, boxes) -> bool:
         return self.checker.shadow_inside_table(name, pose, half) and self.checker.shadow_clear(
-            name, pose, half, on_table
+            name, pose, half, on_table, boxes
         )
 
     # -- push ------------------------------------------------------------------------------
@@ -532,7 +536,9 @@ class ActionGenerator:
                 )
             for across in centres:
                 pose = (along, across, theta) if axis == 0 else (across, along, theta)
-                if self.checker.shadow_clear(manip.spec.name, pose, self.push_unc, on_table):
+                if self.checker.shadow_clear(
+                    manip.spec.name, pose, self.push_unc, on_table, [box for _, box in boxes]
+                ):
                     for d, travel in group:
                         push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
                         if self.stall_per_area and self.solve_distances and travel is not None:
@@ -637,23 +643,26 @@ class ActionGenerator:
         candidates = [min(max(centre, low), high)]
         candidates += [v for bounds in forbidden + ahead for v in bounds if low <= v <= high]
         candidates.sort(key=lambda v: abs(v - centre))
-        allowed = [v for v in candidates if all(not (lo < v < hi) for lo, hi in forbidden)]
-        if not allowed:
-            return []
-        for value in allowed:
-            if all(
-                not (touch_lo < value < touch_hi) or cover_lo <= value <= cover_hi
+        # The nearest allowed centre, and the nearest allowed one that clips no shadow ahead.
+        first = None
+        for value in candidates:
+            if any(lo < value < hi for lo, hi in forbidden):
+                continue
+            if first is None:
+                first = value
+            if not any(
+                touch_lo < value < touch_hi and not cover_lo <= value <= cover_hi
                 for touch_lo, touch_hi, cover_lo, cover_hi in ahead
             ):
-                return [allowed[0]] if abs(value - allowed[0]) <= 1e-6 else [allowed[0], value]
-        return [allowed[0]]
+                return [first] if abs(value - first) <= 1e-6 else [first, value]
+        return [] if first is None else [first]
 
     def _across_span(self, manip, interval, other: int, m_box) -> tuple[float, float]:
         """The range of centres across the push (along axis ``other``) at which the
         manipulator's long side covers the part's centre with 0.1 in to spare and its approach
         shadow (extents ``m_box``) keeps clear of the walls; empty (low > high) if none."""
         reach = 0.5 * manip.length - 0.1
-        low_lim, high_lim = self._across_limits(other)
+        low_lim, high_lim = self._limits[other]
         return (
             max(interval.center[other] - reach, low_lim - m_box[other]),
             min(interval.center[other] + reach, high_lim - m_box[other + 2]),

@@ -36,7 +36,10 @@ outcomes compare and hash equal and the search dedupes them.
 The features of every object come from the belief *before* the push (as in the training
 data), so all of a push's predictions are one batched call of the fast forest, made for the
 rows the semantics has not met before: a row's answer (its prediction, or that it lies outside
-the training domain) is remembered, since a search meets the same rows in many beliefs.
+the training domain) is remembered, since a search meets the same rows in many beliefs. So are
+a push's paddle, the contact graph's rows and structures
+(:class:`~arrange_up.cbst.contact_graph.PushMemo`) and a push's outcome per structure: a push
+met again whose paddle reaches the same objects' beliefs changes them as it did before.
 
 A push returns ``None`` (no prediction) whenever the contact graph says so (see
 :mod:`arrange_up.cbst.contact_graph`), when the push is not axis-aligned, when the
@@ -63,7 +66,15 @@ import numpy as np
 
 from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
 from arrange_up.cbst.choice import model_for
-from arrange_up.cbst.contact_graph import ROBOT, WALL, Node, Paddle, analyse_push
+from arrange_up.cbst.contact_graph import (
+    ROBOT,
+    WALL,
+    Node,
+    Paddle,
+    PushMemo,
+    PushStructure,
+    analyse_push,
+)
 from arrange_up.cbst.data import DEFAULT_GENERATION, GenerationSettings
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
@@ -83,6 +94,9 @@ FIXTURE_REFUSAL = "a pushed object may slip past the end of a fixture ahead"
 PREDICTION_CACHE = 200_000
 #: Contact-graph nodes (an object's belief in a push's frame) a semantics remembers.
 NODE_CACHE = 100_000
+#: Pushes' outcomes (and scenes, structures: :class:`~arrange_up.cbst.contact_graph.PushMemo`)
+#: a semantics remembers.
+OUTCOME_CACHE = 100_000
 #: Shapes and sizes are compared with this tolerance (inches).
 _SIZE_TOL = 1e-6
 #: Why a push has no prediction from a model trained on the planner's pushes to the wall
@@ -91,6 +105,12 @@ TRAINED_PUSH_REFUSAL = "the push sends the paddle elsewhere than the model's tra
 #: How far (in) a push's commanded front may lie from where such a model's training pushes
 #: sent it: the rounding of generated poses (1e-6 in) and distances (1e-4 in), with room.
 TRAINED_PUSH_TOLERANCE = 1e-3
+
+
+#: What a predictable push does (:meth:`CBSTSemantics._outcome`): the reason it has no
+#: prediction after all (None if it has one), its members' new intervals and the number of
+#: model predictions it took.
+_Outcome = tuple[str | None, dict[str, ObjectInterval], int]
 
 
 def _r(value: float) -> float:
@@ -130,6 +150,10 @@ class CBSTSemantics:
         self.simulations = 0
         self._predictions: dict[tuple[float, ...], np.ndarray | None] = {}
         self._nodes: dict[tuple[str, str, ObjectInterval], Node] = {}
+        self._paddles: dict[Push, tuple[CanonicalFrame | None, Paddle | None]] = {}
+        self._last_nodes: dict[str, tuple[IntervalBelief, list[Node]]] = {}
+        self._memo = PushMemo(OUTCOME_CACHE)
+        self._outcomes: dict[tuple, tuple[PushStructure, _Outcome]] = {}
         self.reasons: Counter[str] = Counter()
         self.model = model_for(problem, model)
         card = self.model.card_
@@ -210,25 +234,11 @@ class CBSTSemantics:
     # -- push ---------------------------------------------------------------------------------
     def _push(self, belief: IntervalBelief, push: Push) -> IntervalBelief | None:
         problem = self.problem
-        spec = problem.object(push.manipulator)
-        px, py = spec.push_direction
-        frame = CanonicalFrame.of_vector(*rotate((px, py), push.pose[2]))
-        if frame is None:
+        frame, paddle = self._paddle(push)
+        if frame is None or paddle is None:
             return self._refuse("the push is not axis-aligned")
         d = self.block_size
-        nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
-        push_unc = problem.uncertainty.push
-        xmin, ymin, xmax, ymax = spec.shape.extent
-        along_y = abs(py) > abs(px)  # the push direction in the manipulator's own frame
-        length, thickness = (xmax - xmin, ymax - ymin) if along_y else (ymax - ymin, xmax - xmin)
-        paddle = Paddle(
-            center=frame.pose_to(push.pose),
-            half=frame.half_to(push_unc),
-            box=frame.box_to(self.checker.shadow_box(push.manipulator, push.pose, push_unc)),
-            length=length,
-            thickness=thickness,
-            travel=float(push.distance),
-        )
+        nodes = self._nodes_of(belief, frame)
         table = frame.table_box(problem.table.size)
         wall = table[2] if frame.wall_ahead in problem.table.walls else None
         obstacles = [frame.box_to(box) for box in self.checker.obstacle_boxes.values()]
@@ -238,7 +248,9 @@ class CBSTSemantics:
             name, face, spread = fence
             wall = face
             nodes = [node for node in nodes if node.name != name]
-        structure = analyse_push(paddle, nodes, wall=wall, block_size=d, obstacles=obstacles)
+        structure = analyse_push(
+            paddle, nodes, wall=wall, block_size=d, obstacles=obstacles, memo=self._memo
+        )
         if fence is not None and structure.kind == "predict":
             fixture = dict(belief.objects)[fence[0]]
             box = frame.box_to(self.checker.shadow_box(fence[0], fixture.center, (0.0, 0.0, 0.0)))
@@ -254,13 +266,70 @@ class CBSTSemantics:
             return belief
         if structure.kind == "none":
             return self._refuse(structure.reason)
-        if not self._is_paddle(spec):
-            return self._refuse(f"{push.manipulator!r} is not the paddle the model was trained on")
+        # The outcome depends on the push, the structure and its members' nodes (which the
+        # memo's structure stands for), and on a fence's pose: remembered without a fence.
+        key = (push, id(structure)) if fence is None else None
+        known = self._outcomes.get(key) if key is not None else None
+        if known is None:
+            outcome = self._outcome(push, frame, paddle, structure, nodes, table, wall, spread)
+            if key is not None:
+                if len(self._outcomes) >= OUTCOME_CACHE:
+                    self._outcomes.clear()
+                self._outcomes[key] = (structure, outcome)  # the structure keeps its id
+        else:
+            outcome = known[1]
+        refusal, updates, simulated = outcome
+        self.simulations += simulated
+        if refusal is not None:
+            return self._refuse(refusal)
+        objects = dict(belief.objects)
+        objects.update(updates)
+        return self._belief(objects)
+
+    def _paddle(self, push: Push) -> tuple[CanonicalFrame | None, Paddle | None]:
+        """The push's canonical frame and its paddle in that frame (None, None when the push
+        is not axis-aligned); remembered per push, since a search offers the same pushes in
+        many beliefs."""
+        known = self._paddles.get(push)
+        if known is not None:
+            return known
+        spec = self.problem.object(push.manipulator)
+        px, py = spec.push_direction
+        frame = CanonicalFrame.of_vector(*rotate((px, py), push.pose[2]))
+        paddle = None
+        if frame is not None:
+            push_unc = self.problem.uncertainty.push
+            xmin, ymin, xmax, ymax = spec.shape.extent
+            along_y = abs(py) > abs(px)  # the push direction in the manipulator's own frame
+            length, thickness = (
+                (xmax - xmin, ymax - ymin) if along_y else (ymax - ymin, xmax - xmin)
+            )
+            paddle = Paddle(
+                center=frame.pose_to(push.pose),
+                half=frame.half_to(push_unc),
+                box=frame.box_to(self.checker.shadow_box(push.manipulator, push.pose, push_unc)),
+                length=length,
+                thickness=thickness,
+                travel=float(push.distance),
+            )
+        if len(self._paddles) >= OUTCOME_CACHE:
+            self._paddles.clear()
+        self._paddles[push] = (frame, paddle)
+        return frame, paddle
+
+    def _outcome(self, push, frame, paddle, structure, nodes, table, wall, spread) -> _Outcome:
+        """What a predictable push ``structure`` does: ``(refusal, updates, simulated)``, the
+        reason it has no prediction (None if it has one), the members' new intervals and the
+        number of model predictions it took (counted even when refused afterwards)."""
+        problem = self.problem
+        d = self.block_size
+        if not self._is_paddle(problem.object(push.manipulator)):
+            return f"{push.manipulator!r} is not the paddle the model was trained on", {}, 0
         assert wall is not None
         if self._trained_wall_push == "planner" and not self._sent_as_trained(
             paddle, wall, structure.length
         ):
-            return self._refuse(TRAINED_PUSH_REFUSAL)
+            return TRAINED_PUSH_REFUSAL, {}, 0
         by_name = {node.name: node for node in nodes}
 
         def neighbour(key):
@@ -284,13 +353,13 @@ class CBSTSemantics:
                     owner.append(k)
         pred = self._predict(rows)
         if pred is None:
-            return self._refuse("a pushed object's belief is outside the model's training domain")
-        self.simulations += len(rows)
+            return "a pushed object's belief is outside the model's training domain", {}, 0
+        simulated = len(rows)
         owner_arr = np.asarray(owner, dtype=int)
         low_wall, high_wall = frame.side_walls
         v_min = table[1] + 0.5 * d if low_wall in problem.table.walls else -math.inf
         v_max = table[3] - 0.5 * d if high_wall in problem.table.walls else math.inf
-        objects = dict(belief.objects)
+        updates: dict[str, ObjectInterval] = {}
         for k, member in enumerate(structure.members):
             cur = by_name[member.name]
             if member.grazed:
@@ -307,24 +376,34 @@ class CBSTSemantics:
                 half = frame.half_from(
                     (0.5 * (u_high - u_low), 0.5 * (v_high - v_low), cur.half[2])
                 )
-                objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
+                updates[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
                 continue
             dx, dy, dth, slip = pred[owner_arr == k].max(axis=0)[:4]
             if slip > BUCKLE_LIMIT:
-                return self._refuse("the model predicts that the train may buckle")
+                return "the model predicts that the train may buckle", {}, simulated
             x_max = wall - (member.depth - 0.5) * d
             u_low = x_max - spread - dx
             u_high = x_max + spread + max(slip, self.allowance(member.depth))
             v = cur.center[1]
             v_low, v_high = max(v - dy, v_min), min(v + dy, v_max)
             if v_low > v_high:
-                return self._refuse(f"{member.name!r} would end outside the table")
+                return f"{member.name!r} would end outside the table", {}, simulated
             canonical = (0.5 * (u_low + u_high), 0.5 * (v_low + v_high), 0.0)
             half = frame.half_from(
                 (0.5 * (u_high - u_low), 0.5 * (v_high - v_low), math.radians(dth))
             )
-            objects[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
-        return self._belief(objects)
+            updates[member.name] = self._interval(member.name, frame.pose_from(canonical), half)
+        return None, updates, simulated
+
+    def _nodes_of(self, belief: IntervalBelief, frame: CanonicalFrame) -> list[Node]:
+        """The contact graph's nodes of ``belief``'s objects in ``frame``; the last belief's
+        are kept per direction, since a search evaluates one belief's pushes in a row."""
+        last = self._last_nodes.get(frame.direction)
+        if last is not None and last[0] is belief:
+            return last[1]
+        nodes = [self._node(frame, name, iv) for name, iv in belief.objects]
+        self._last_nodes[frame.direction] = (belief, nodes)
+        return nodes
 
     def _node(self, frame: CanonicalFrame, name: str, interval: ObjectInterval) -> Node:
         """The contact graph's node of ``name`` at ``interval`` in ``frame``; remembered (up to
