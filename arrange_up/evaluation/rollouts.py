@@ -20,7 +20,8 @@ The rollout fails at the first of these (and records which):
   is not there: the physics' ``ValueError``, whose message is the reason); a push starts with
   shapes overlapping by more than the physics' ``overlap_tolerance`` (0.02 in; the paddle was
   put down on a part); or a place puts its object overlapping another object, a wall or an
-  obstacle by more than that tolerance (the physics does not check places).
+  obstacle by more than that tolerance (the physics does not check places). Their reason and
+  detail quote the tolerance and the depth in the problem's length unit, as every message does.
   With ``landing="shove"`` a push that starts overlapping is not a failure: the physics
   resolves the overlap (the paddle shoves what it was put down on aside) and the rollout goes
   on; the default ``landing="fail"`` is the rule above (:data:`LANDINGS`).
@@ -194,6 +195,7 @@ class Rollouts:
         a time through here."""
         problem = self.problem
         tolerance = self.settings.overlap_tolerance
+        length = _length_text(problem)
         noise = draw_noise(problem, action, rng)
         try:
             outcome = simulation.simulate(problem, state, action, noise, self.push_settings)
@@ -206,8 +208,8 @@ class Rollouts:
                 Failure(
                     ACTION_FAILED,
                     k,
-                    f"{PUSH_OVERLAP_REASON} (by more than {tolerance:g} in)",
-                    f"deepest overlap {outcome.overlap:.4f} in",
+                    f"{PUSH_OVERLAP_REASON} (by more than {length(tolerance, 'g')})",
+                    f"deepest overlap {length(outcome.overlap, '.4f')}",
                 ),
             )
         if outcome.status is StepStatus.NOT_AT_REST:
@@ -224,11 +226,23 @@ class Rollouts:
                     Failure(
                         ACTION_FAILED,
                         k,
-                        f"placed overlapping {other} (by more than {tolerance:g} in)",
-                        f"overlap {depth:.4f} in",
+                        f"placed overlapping {other} (by more than {length(tolerance, 'g')})",
+                        f"overlap {length(depth, '.4f')}",
                     ),
                 )
         return Step(state, outcome, None)
+
+
+def _length_text(problem: ArrangementProblem):
+    """``text(value, spec)``: a length in inches as the text of ``problem``'s file, converted to
+    its length unit and formatted with ``spec`` (``text(0.02, "g")`` is ``"0.0508 cm"`` for a
+    problem written in centimetres, ``"0.02 in"`` for one in inches)."""
+    units = problem.units
+
+    def text(value: float, spec: str) -> str:
+        return f"{units.length_out(value):{spec}} {units.length}"
+
+    return text
 
 
 def execute_plan(

@@ -28,6 +28,7 @@ from arrange_up.evaluation.reliability import EvaluationProgress, wilson_interva
 from arrange_up.evaluation.rollouts import execute_plan, simulate_rollout, trace_rollout
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, write_json_atomic
+from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.problem import (
     ArrangementProblem,
     Goal,
@@ -138,6 +139,38 @@ def test_inapplicable_actions_are_recorded_with_their_index_and_reason():
     result = evaluate_plan(problem, stacked, rollouts=2, workers=1, keep_records=True)
     assert result.failures.action_failures[0].reason.startswith("placed overlapping A")
     assert result.records[0].failure.detail.startswith("overlap 0.")
+
+
+#: Two 5 cm blocks and a paddle, written in centimetres.
+CM_PAIR = """
+name: cm-pair
+units: {length: cm}
+table: {size: [50, 30]}
+objects:
+  A: {kind: part, shape: {box: [5, 5]}}
+  B: {kind: part, shape: {box: [5, 5]}}
+  paddle: {kind: manipulator, shape: {box: [6.35, 0.38]}}
+goal: {tolerance: [0.5, 0.5], poses: {A: [10, 10, 0], B: [20, 10, 0]}}
+"""
+
+
+def test_an_overlap_is_reported_in_the_files_length_unit():
+    problem = load_problem_text(CM_PAIR, "cm-pair.yaml")
+    # B put down 1 cm into A; the paddle put down across A's lower edge (actions are in
+    # inches)
+    a, b = (10 / 2.54, 10 / 2.54, 0.0), (14 / 2.54, 10 / 2.54, 0.0)
+    stacked = [Place("A", a), Place("B", b)]
+    result = evaluate_plan(problem, stacked, rollouts=1, workers=1, keep_records=True)
+    assert result.failures.action_failures[0].reason == (
+        "placed overlapping A (by more than 0.0508 cm)"
+    )
+    assert result.records[0].failure.detail.endswith(" cm")
+    landed = [Place("A", a), Push("paddle", (a[0], 8 / 2.54, 0.0), 1.0)]  # 0.5 cm into A
+    result = evaluate_plan(problem, landed, rollouts=1, workers=1, keep_records=True)
+    assert result.failures.action_failures[0].reason == (
+        "the push started with shapes overlapping (by more than 0.0508 cm)"
+    )
+    assert result.records[0].failure.detail.endswith(" cm")
 
 
 def test_off_table_and_not_at_rest_are_told_apart(monkeypatch):
