@@ -11,12 +11,14 @@ kinds: a narrowing squeeze, a detour round a post, a relative pair whose referen
 an open-table goal that needs a fixture, an L part into a corner, a 5-block T, a column of four,
 a tight row; four that need the planner's own fence (fence-corner; a corner of two fences on
 a wall-less table twice, fence-open-corner and fence-middle-corner; and fence-row, a row pressed
-against one); and four with a fixed post: on the straight line to the goal in the open, on the
+against one); four with a fixed post: on the straight line to the goal in the open, on the
 wall between a block lying on that wall and its goal, just beyond the goal, and flush with the
-goal), plans as ``arrange-up plan FILE --particles N --semantics S`` does (seed 0, one worker),
-then evaluates a found plan with ``--rollouts`` noisy rollouts (seed 0) and prints a row:
-status, nodes expanded, planning seconds, plan length, successes, and the planner's reason when
-no plan was found. Each row is appended to the CSV (if given) as soon as it is measured.
+goal; and eight written blind by an outsider to the planner, in other units, shapes, walls and
+paddles, four with relative goals), plans as ``arrange-up plan FILE --particles N --semantics
+S`` does (seed 0, one worker), then evaluates a found plan with ``--rollouts`` noisy rollouts
+(seed 0) and prints a row: status, nodes expanded, planning seconds, plan length, successes,
+and the planner's reason when no plan was found. Each row is appended to the CSV (if given) as
+soon as it is measured.
 """
 
 from __future__ import annotations
