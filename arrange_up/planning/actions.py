@@ -847,14 +847,7 @@ class ActionGenerator:
             and not self._inside_goal(interval, target, 1 - axis)
         ):
             pushes.append((clear, clear))
-        u = self.problem.uncertainty
-        over = wall_overdrive(
-            self.problem.controller,
-            u.friction,
-            u.part_density,
-            self.areas[name],
-            self.push_unc[axis],
-        )
+        over = self._overdrive(self.areas[name], axis)
         if over is not None and not self._inside_goal(interval, target, axis):
             pushes.append((travel + over, None))
         return pushes
@@ -929,11 +922,7 @@ class ActionGenerator:
         :func:`~arrange_up.physics.stall.wall_overdrive`."""
         if not self.compressed_wall_pushes:
             return stop
-        u = self.problem.uncertainty
-        area = sum(self.areas[q] for q in parts)
-        over = wall_overdrive(
-            self.problem.controller, u.friction, u.part_density, area, self.push_unc[axis]
-        )
+        over = self._overdrive(sum(self.areas[q] for q in parts), axis)
         if over is None:
             return stop
         length = 0.0
@@ -941,6 +930,14 @@ class ActionGenerator:
             box = self.checker.shadow_box(q, belief.get(q).center, (0.0, 0.0, 0.0))  # type: ignore[union-attr]
             length += box[axis + 2] - box[axis]
         return wall_push_front(stop, length, over)
+
+    def _overdrive(self, area: float, axis: int) -> float | None:
+        """The problem's :func:`~arrange_up.physics.stall.wall_overdrive` for ``area`` square
+        inches of parts pressed along ``axis`` (None under the servo)."""
+        u = self.problem.uncertainty
+        return wall_overdrive(
+            self.problem.controller, u.friction, u.part_density, area, self.push_unc[axis]
+        )
 
     def _settled(self, parts: tuple[str, ...], belief: IntervalBelief, axis: int) -> bool:
         """Whether every one of ``parts`` lies within its goal interval along ``axis`` in every
