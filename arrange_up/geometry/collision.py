@@ -169,6 +169,9 @@ class PenetrationDepths:
                     fixed.append((spec.name, transform_points(part, spec.pose)))
         self.fixed = fixed
         """``(label, world polygon)`` of every wall (``"the left wall"``) and obstacle part."""
+        self._fixed_bounds = [
+            (*poly.min(axis=0).tolist(), *poly.max(axis=0).tolist()) for _, poly in fixed
+        ]
 
     def deepest(self, state: WorldState, name: str) -> tuple[str, float]:
         """The deepest overlap of ``name`` (on the table in ``state``) with any other object of
@@ -176,6 +179,11 @@ class PenetrationDepths:
         first found wins a tie (objects in state order, then walls, then obstacles)."""
         pose = state.pose(name)
         assert pose is not None
+        return self.deepest_at(state, name, pose)
+
+    def deepest_at(self, state: WorldState, name: str, pose: Pose) -> tuple[str, float]:
+        """:meth:`deepest` for ``name`` put down at ``pose``, whether or not ``state`` holds it
+        (a manipulator about to push, say); ``name``'s own entry in ``state`` is ignored."""
         placed = [transform_points(part, pose) for part in self.parts[name]]
         reach = self.radius[name]
         worst = ("nothing", 0.0)
@@ -192,10 +200,9 @@ class PenetrationDepths:
                     depth = convex_penetration(mine, world)
                     if depth > worst[1]:
                         worst = (other, depth)
-        lo = np.array([pose[0] - reach, pose[1] - reach])
-        hi = np.array([pose[0] + reach, pose[1] + reach])
-        for label, poly in self.fixed:
-            if np.any(poly.max(axis=0) < lo) or np.any(poly.min(axis=0) > hi):
+        x, y = pose[0], pose[1]
+        for (label, poly), (x0, y0, x1, y1) in zip(self.fixed, self._fixed_bounds, strict=True):
+            if x1 < x - reach or y1 < y - reach or x0 > x + reach or y0 > y + reach:
                 continue
             for mine in placed:
                 depth = convex_penetration(mine, poly)

@@ -278,23 +278,31 @@ def translate_polygon(poly: Sequence[Point], dx: float, dy: float) -> Polygon:
     return tuple((float(x) + dx, float(y) + dy) for x, y in poly)
 
 
-def convex_penetration(a: np.ndarray, b: np.ndarray) -> float:
-    """Penetration depth of two convex ``(N, 2)`` polygons: the smallest overlap of their
-    projections over the edge normals of both (separating axis theorem); ``0.0`` when a
-    separating axis exists (touching counts as apart). Either orientation; degenerate
-    (zero-length) edges are skipped."""
+def convex_penetration(a: Sequence[Point] | np.ndarray, b: Sequence[Point] | np.ndarray) -> float:
+    """Penetration depth of two convex polygons (``(N, 2)`` arrays or point sequences): the
+    smallest overlap of their projections over the edge normals of both (separating axis
+    theorem); ``0.0`` when a separating axis exists (touching counts as apart). Either
+    orientation; degenerate (zero-length) edges are skipped.
+
+    In plain Python floats: the polygons have a few vertices, where numpy's per-call overhead
+    would dominate (every push of the simulation tests its paddle's landing with it)."""
+    pa_ = a.tolist() if isinstance(a, np.ndarray) else [(float(x), float(y)) for x, y in a]
+    pb_ = b.tolist() if isinstance(b, np.ndarray) else [(float(x), float(y)) for x, y in b]
     best = math.inf
-    for poly in (a, b):
-        edges = np.roll(poly, -1, axis=0) - poly
-        normals = np.stack([edges[:, 1], -edges[:, 0]], axis=1)
-        lengths = np.hypot(normals[:, 0], normals[:, 1])
-        normals = normals[lengths > 0] / lengths[lengths > 0, None]
-        pa, pb = a @ normals.T, b @ normals.T
-        overlap = np.minimum(pa.max(axis=0), pb.max(axis=0)) - np.maximum(
-            pa.min(axis=0), pb.min(axis=0)
-        )
-        smallest = float(overlap.min())
-        if smallest <= 0.0:
-            return 0.0
-        best = min(best, smallest)
+    for poly in (pa_, pb_):
+        n = len(poly)
+        for i in range(n):
+            x0, y0 = poly[i]
+            x1, y1 = poly[(i + 1) % n]
+            nx, ny = y1 - y0, x0 - x1
+            length = math.hypot(nx, ny)
+            if length <= 0.0:
+                continue
+            nx, ny = nx / length, ny / length
+            on_a = [x * nx + y * ny for x, y in pa_]
+            on_b = [x * nx + y * ny for x, y in pb_]
+            overlap = min(max(on_a), max(on_b)) - max(min(on_a), min(on_b))
+            if overlap <= 0.0:
+                return 0.0
+            best = min(best, overlap)
     return best

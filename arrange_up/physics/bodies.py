@@ -1,6 +1,7 @@
 """The problem's shapes compiled once for the simulation: cffi vertex arrays of every body's
 convex parts, per-unit-density mass integrals (area, moment, ``integral(|r| dA)`` for the
-table friction), and the walls and obstacles as static polygons in world coordinates."""
+table friction), the walls and obstacles as static polygons in world coordinates, and the
+exact penetration depths that a manipulator's landing is tested with."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 from pymunk._chipmunk_cffi import ffi, lib
 
 from arrange_up.geometry.boxes import WALL_NAMES, box_corners, wall_boxes
+from arrange_up.geometry.collision import PenetrationDepths
 from arrange_up.geometry.se2 import transform_point
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, Table
 
@@ -73,6 +75,7 @@ class _Compiled:
     table: Table
     wall_thickness: float
     parts_area: float  # of all the problem's parts, for the force clip (push_force)
+    depths: PenetrationDepths  # exact overlaps of shapes at poses (a paddle's landing)
 
 
 _IDENTITY = ffi.new("cpTransform *", (1.0, 0.0, 0.0, 1.0, 0.0, 0.0))[0]
@@ -114,7 +117,15 @@ def _compile(problem: ArrangementProblem, wall_thickness: float) -> _Compiled:
             radius=spec.shape.radius,
         )
     parts_area = sum(spec.shape.area for spec in problem.parts)  # as push_force sums it
-    compiled = _Compiled(problem, bodies, tuple(statics), problem.table, wall_thickness, parts_area)
+    compiled = _Compiled(
+        problem,
+        bodies,
+        tuple(statics),
+        problem.table,
+        wall_thickness,
+        parts_area,
+        PenetrationDepths(problem),
+    )
     if len(_CACHE) >= _CACHE_SIZE:
         _CACHE.pop(next(iter(_CACHE)))
     _CACHE[key] = compiled

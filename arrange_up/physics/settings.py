@@ -79,7 +79,7 @@ class PhysicsSettings:
     settle_steps: int = 2
     """Steps run after writing the state, before driving the manipulator: the thesis ran "a
     couple of time steps" so the engine builds its contact state first. The overlap check reads
-    the contacts they build (0 turns the check off)."""
+    the contacts they build and the manipulator's landing geometry (0 turns the check off)."""
     push_speed: float = 3.0
     """Speed limit of the manipulator (in/s): a careful robot push, 0.0125 in per step."""
     push_force: float = 400.0

@@ -17,7 +17,8 @@ Actions
   nothing: the planner's precondition guarantees the placed object overlaps nothing.
 * **Pick** removes the object.
 * **Push** (thesis §2.4.1) builds a fresh space, writes the state, puts the manipulator down at
-  the approach pose (commanded + ``noise.pose_offset``), runs ``settle_steps`` steps, drives it
+  the approach pose (commanded + ``noise.pose_offset``), runs ``settle_steps`` steps (a landing
+  deeper than ``overlap_tolerance``, in the contacts or the geometry, is ``OVERLAP``), drives it
   toward the reference point ``distance`` inches along its push direction until it stops moving,
   stops driving it, waits until every other body is at rest, and lifts it off.
 
@@ -523,11 +524,15 @@ def _push(
 
         if watch is not None:
             step = _watched_step(watch, bodies)
-        # 4. settle, then look for overlaps in the contacts the engine built
+        # 4. settle, then look for overlaps in the contacts the engine built, and for the
+        # paddle's own landing in the geometry (the contacts miss a concentric landing)
         for _ in range(s.settle_steps):
             step(space, dt)
         steps = s.settle_steps
-        overlap = _deepest_overlap(space) if s.settle_steps else 0.0
+        overlap = 0.0
+        if s.settle_steps:
+            _, landing = compiled.depths.deepest_at(state, name, (px, py, pth))
+            overlap = max(_deepest_overlap(space), landing)
 
         # 5. drive until the paddle is still, then stop driving and wait until every other
         # body is at rest. Stopping turns the drive into a brake (no bias: no force toward the

@@ -192,6 +192,17 @@ def test_overlapping_approach_is_reported():
     state = state_of(problem, b0=(3.0, 2.5, 0.0))
     outcome = simulate(problem, state, Push("paddle", (2.6, 2.5, EAST), 1.0))  # inside b0
     assert outcome.status is StepStatus.OVERLAP
+
+
+@pytest.mark.parametrize("theta", [EAST, NORTH])
+def test_paddle_put_down_centred_on_a_block_is_reported(theta):
+    # Chipmunk builds no contact for two concentric symmetric polygons; the landing test is
+    # geometric, so the paddle's thickness (0.15 in) is the depth found.
+    problem = make_problem(1)
+    state = state_of(problem, b0=(3.0, 2.5, 0.0))
+    outcome = simulate(problem, state, Push("paddle", (3.0, 2.5, theta), 1.0))
+    assert outcome.status is StepStatus.OVERLAP
+    assert outcome.overlap == pytest.approx(2 * PADDLE_HALF)
     assert outcome.overlap > DEFAULT_SETTINGS.overlap_tolerance
 
 
