@@ -152,7 +152,7 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
 from arrange_up.physics.stall import stall_per_area, wall_overdrive, wall_push_front
-from arrange_up.planning.fences import Fences
+from arrange_up.planning.fences import NO_FENCE, FenceAhead, Fences
 from arrange_up.planning.mating import Mates
 from arrange_up.planning.obstacles import GAP, Obstacles, far_face
 
@@ -492,23 +492,16 @@ class ActionGenerator:
         else:
             along = part_box[axis + 2] + APPROACH_GAP - m_box[axis]
         front_nominal = sign * along + 0.5 * manip.thickness  # signed coordinate of the front
+        fence = (
+            self.fences.ahead(name, interval, belief, axis, sign, routes or {})
+            if self.fences.needs
+            else NO_FENCE
+        )
         # An open push of a part that needs a fence no fence can press yet is a passage (past
         # another part, say): it is also offered where it clips no shadow ahead.
-        passing = bool(self.fences.needs) and self.fences.passing(
-            name, interval, belief, axis, sign, routes or {}
-        )
+        passing = fence.passing
         distances, jammed = self._distances(
-            name,
-            interval,
-            belief,
-            axis,
-            sign,
-            front_nominal,
-            ladder,
-            routes or {},
-            detour,
-            away,
-            passing,
+            name, interval, belief, axis, sign, front_nominal, ladder, routes, detour, away, fence
         )
         pushes = []
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
@@ -689,13 +682,14 @@ class ActionGenerator:
         routes=None,
         detour: float | None = None,
         away: bool = False,
-        passing: bool = False,
+        fence: FenceAhead = NO_FENCE,
     ) -> tuple[list[tuple[float, float | None]], set[float]]:
         """Candidate travel distances of the manipulator (see the module docstring), each with
         the travel of the part it is meant for (``None`` for a push to the wall, a squeeze or a
         push cut short), and the distances among them that jam the part on an obstacle.
         ``detour``: a sideways travel round an obstacle (:meth:`_detours`); ``away``: the push
-        moves the part away from its goal, so only the detour is offered."""
+        moves the part away from its goal, so only the detour is offered; ``fence``: what the
+        fences say of these pushes (:meth:`~arrange_up.planning.fences.Fences.ahead`)."""
         size = self.problem.table.size[axis]
         direction = _DIRECTION_OF[(axis, sign)]
         wall = _WALL_AHEAD[direction]
@@ -728,25 +722,20 @@ class ActionGenerator:
         # that end in the open along this axis are not offered: by the problem's own noise
         # they cannot stop the part within its tolerance (planning.fences).
         target = self.place_target(name, belief)
-        fenced, levelling = False, None
+        fenced, levelling = fence.fenced, None
         # pushes meant to press the part against something fixed: not cut short (_cut_short)
         squeezes: set[float] = set()
-        if self.fences.needs and name in self.fences.goal_boxes:
-            face = self.fences.face_ahead(name, interval, belief, axis, sign)
-            if face is not None and not (
-                self.compliant
-                and not self.settled_wall_pushes
-                and target is not None
-                and self._inside_goal(interval, target, axis)
-            ):
-                candidates.append(self._stop_front(sign * face, (name,), belief, axis) - front)
-                squeezes.add(candidates[-1])
-            fenced = self.fences.replaces_open_pushes(
-                name, interval, axis, sign, face, routes or {}
-            )
-            if fenced:
-                # a corner: the part first brought level with a fence of the other axis
-                levelling = self.fences.level(name, interval, belief, axis, routes or {})
+        if fence.face is not None and not (
+            self.compliant
+            and not self.settled_wall_pushes
+            and target is not None
+            and self._inside_goal(interval, target, axis)
+        ):
+            candidates.append(self._stop_front(sign * fence.face, (name,), belief, axis) - front)
+            squeezes.add(candidates[-1])
+        if fenced:
+            # a corner: the part first brought level with a fence of the other axis
+            levelling = self.fences.level(name, interval, belief, axis, routes or {})
         travels: dict[float, float | None] = dict.fromkeys(candidates)
         # Free travel a distance must exceed by MIN_PUSH: to the centre state's contact, or, for
         # a narrowing push, to the contact of the rearmost state.
@@ -761,7 +750,7 @@ class ActionGenerator:
                     level = sign * (levelling - interval.center[axis])
                     if level > MIN_PUSH:
                         travels.setdefault(gap + level + stall, level)
-            elif passing:
+            elif fence.passing:
                 # towards the goal, short of the fence still to be put down; no narrowing:
                 # the fence does that
                 aim = min(

@@ -87,6 +87,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from arrange_up.belief.states import IntervalBelief, fixture_turns
 from arrange_up.geometry.boxes import box_row
@@ -117,6 +118,23 @@ def fixture_angles(problem: ArrangementProblem, name: str) -> list[float]:
     """The distinct right-angle turns at which fixture ``name`` is placed, by the repair's grid
     and by fences (:func:`~arrange_up.belief.states.fixture_turns`)."""
     return list(fixture_turns(problem.object(name).shape))
+
+
+@dataclass(frozen=True)
+class FenceAhead:
+    """What fences mean for the pushes of one part in one direction (:meth:`Fences.ahead`):
+    ``face``, the face of a fence on the table ahead that can press the part
+    (:meth:`Fences.face_ahead`, ``None`` if none); ``fenced``, whether the pushes that end in
+    the open give way to a fence (:meth:`Fences.replaces_open_pushes`); ``passing``, whether
+    they are passing pushes (:meth:`Fences.passing`)."""
+
+    face: float | None = None
+    fenced: bool = False
+    passing: bool = False
+
+
+#: A part no fence concerns.
+NO_FENCE = FenceAhead()
 
 
 class Fences:
@@ -268,6 +286,30 @@ class Fences:
             for p in places
         )
 
+    def ahead(
+        self,
+        part: str,
+        interval,
+        belief: IntervalBelief,
+        axis: int,
+        sign: int,
+        routes: dict[tuple[str, int, int], list[Place]],
+    ) -> FenceAhead:
+        """The fences' say on the pushes of ``part`` along ``axis`` towards ``sign``
+        (:class:`FenceAhead`), each test made once: :data:`NO_FENCE` for a part with no fenced
+        goal face."""
+        if part not in self.goal_boxes:
+            return NO_FENCE
+        face = self.face_ahead(part, interval, belief, axis, sign)
+        fenced = self.replaces_open_pushes(part, interval, axis, sign, face, routes)
+        passing = (
+            bool(self.problem.fixtures)
+            and self.needed(part, axis)
+            and not self.needed(part, 1 - axis)
+            and not fenced
+        )
+        return FenceAhead(face, fenced, passing)
+
     def passing(
         self,
         part: str,
@@ -281,10 +323,7 @@ class Fences:
         (module docstring, *Passing*): the part needs a fence along this axis only, a fixture
         is still to be put down for it, and no fence can press it now
         (:meth:`replaces_open_pushes`)."""
-        if not self.problem.fixtures or not self.needed(part, axis) or self.needed(part, 1 - axis):
-            return False
-        face = self.face_ahead(part, interval, belief, axis, sign)
-        return not self.replaces_open_pushes(part, interval, axis, sign, face, routes)
+        return self.ahead(part, interval, belief, axis, sign, routes).passing
 
     def passing_aim(self, part: str, interval, axis: int, sign: int) -> float:
         """The farthest coordinate along ``axis`` (towards ``sign``) a passing push takes
