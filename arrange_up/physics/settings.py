@@ -74,6 +74,13 @@ class PhysicsSettings:
     stuck_iterations: int | None = None
     """Solver iterations per step once ``stuck_time`` has passed (``None``: the controller's,
     20 for both)."""
+    stall_window: float | None = None
+    """Once ``stuck_time`` has passed, the drive also ends when the paddle has advanced along
+    its push by less than the rest speed (``rest_linear_tol`` per ``rest_interval``) on
+    average over the last ``stall_window`` seconds: a stalled paddle whose wedge still chatters
+    (back and forth, or creeping sideways along a wall), which the check-to-check rest test
+    reads as motion, so the drive ran to the cap. 0 turns this off; ``None``: the
+    controller's (the servo 0, the compliant controller 0.5; ``docs/design/physics.md``)."""
     max_time: float = 20.0
     """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
     settle_steps: int = 2
@@ -124,6 +131,7 @@ class PhysicsSettings:
             "overlap_tolerance",
             "sleep_time",
             "stuck_time",
+            "stall_window",
         ):
             value = getattr(self, name)
             if value is not None and not value >= 0:
@@ -175,6 +183,7 @@ SERVO_VALUES: dict[str, float | int] = {
     "sleep_time": 0.0,
     "stuck_time": 0.0,
     "stuck_iterations": 20,
+    "stall_window": 0.0,
 }
 """The servo's settling and rest settings: those every push used before they were chosen
 per controller. The servo keeps them, so that its plans, goldens and measurements stay
@@ -190,12 +199,14 @@ COMPLIANT_VALUES: dict[str, float | int] = {
     "sleep_time": 0.05,
     "stuck_time": 1.0,
     "stuck_iterations": 20,
+    "stall_window": 0.5,
 }
 """The compliant controller's settling and rest settings, chosen on the accuracy benchmark
 (``benchmarks/push_accuracy.py``; the alternatives measured are in ``docs/design/physics.md``):
 a check every 3 steps (0.0125 s) with the old speed threshold (1.25e-4 in per check is the old
 1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep; a push
-not at rest 1 s after its set point's end is solved at 20 iterations from then on. About
+not at rest 1 s after its set point's end is solved at 20 iterations from then on, and its
+drive ends once the paddle has made no progress along the push for 0.5 s. About
 0.7x the steps and 0.55-0.6x the time of the servo's values, final poses as close to the
 reference."""
 

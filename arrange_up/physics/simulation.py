@@ -144,7 +144,10 @@ one interval per push and still ends every push with two consecutive still check
 body). A compliant push not at rest ``stuck_time`` (1 s) after its set point's end is solved
 with ``stuck_iterations`` (20) from then on: a paddle that has turned and presses a tilted part
 into a wall or a post wedges it, and at 5 or 10 iterations that wedge chatters until the cap
-(the servo keeps its iterations throughout). The whole push is capped at ``max_time`` (20 s) of
+(the servo keeps its iterations throughout). From then on its drive also ends once the paddle
+has advanced along the push by less than the rest speed over ``stall_window`` (0.5 s): a wedge
+that still chatters, the paddle rocking or creeping sideways with the part along a wall,
+never passes the check-to-check rest test. The whole push is capped at ``max_time`` (20 s) of
 simulated time; a cap hit is reported as ``NOT_AT_REST`` with the poses at the cap, never
 silently truncated.
 
@@ -184,6 +187,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -596,10 +600,17 @@ def _push(
             stuck_at = math.ceil((setpoint_end + s.stuck_time) / dt)
         else:
             stuck_at = max_steps + 1
+        # ...and, once stuck, its drive ends when the paddle's progress along the push over the
+        # last `stall_window` is below the rest speed: chatter is not motion (settings).
+        window = round(s.stall_window / (interval * dt)) if s.stall_window > 0.0 else 0
+        window_progress = s.rest_linear_tol * window
+        progress: deque[float] = deque(maxlen=window + 1)
+        stuck = False
         while True:
             if steps >= stuck_at:
                 lib.cpSpaceSetIterations(space, s.stuck_iterations)
                 stuck_at = max_steps + 1
+                stuck = True
             if steps + interval > max_steps:
                 if driving:
                     advance(max_steps - steps)
@@ -624,7 +635,11 @@ def _push(
                 last_x, last_y = pos.x, pos.y
                 # The compliant paddle must also have stopped turning, its set point at its end.
                 done = drive is not None or track.still(ang_tol)
-                if ex * ex + ey * ey < lin2 and done:
+                if stuck and window:
+                    progress.append(pos.x * dx + pos.y * dy)
+                if len(progress) > window and abs(progress[-1] - progress[0]) < window_progress:
+                    paddle_still = need  # stalled: the drive ends below
+                elif ex * ex + ey * ey < lin2 and done:
                     paddle_still += 1
                 else:
                     paddle_still = 0

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from arrange_up.io.yaml_problem import load_problem
 from arrange_up.model.problem import (
     SERVO_CONTROLLER,
     ArrangementProblem,
@@ -24,7 +25,7 @@ from arrange_up.model.problem import (
     Table,
     Uncertainty,
 )
-from arrange_up.model.world import ActionNoise, Pick, Place, Push, WorldState
+from arrange_up.model.world import ActionNoise, Pick, Place, Push, WorldState, draw_noise
 from arrange_up.physics.bodies import _abs_r_integral
 from arrange_up.physics.simulation import (
     DEFAULT_SETTINGS,
@@ -426,3 +427,22 @@ def test_bench_physics_runs_in_process():
         assert row["not_at_rest"] == 0 and row["not_ok"] == 0
         assert row["pushes_per_second"] > 0
     assert len(messages) == len(SCENES)
+
+
+def test_a_chattering_press_into_a_wall_ends_its_drive_once_stalled():
+    # fence-row's press of B into the bottom wall with A elsewhere on the table: in this noise
+    # draw the wedge of paddle, B and wall chatters (B creeping along the wall) with every
+    # check-to-check rest test failing, so without the stall window it ran to the 20 s cap.
+    problem = load_problem(ROOT / "tests" / "problems" / "fresh" / "fence-row.yaml")
+    push = Push("paddle", (6.0, 4.266, -math.pi), 4.191)
+    rng = np.random.default_rng(1)
+    theta, noise = rng.uniform(-0.09, 0.09), draw_noise(problem, push, rng)
+    state = WorldState.from_mapping(problem, {"B": (6.0, 3.0, theta), "A": (2.0, 3.0, 0.0)})
+    chattering = simulate(problem, state, push, noise, PhysicsSettings(stall_window=0.0))
+    assert chattering.status is StepStatus.NOT_AT_REST
+    outcome = simulate(problem, state, push, noise)
+    assert outcome.status is StepStatus.OK
+    assert outcome.sim_time < 5.0
+    x, y, th = outcome.state.pose("B")
+    assert y == pytest.approx(0.5, abs=0.01)  # pressed against the wall
+    assert abs(th) < 0.02
