@@ -129,8 +129,8 @@ for _servo, _prefix in ((False, ""), (True, "servo-")):
     CASES[f"{_prefix}evaluate-blocks-4-p10-s0"] = _evaluation_case(
         "blocks-4", "particles", 10, 0, _servo
     )
-    # Under the compliant controller the CBST cases pin exhausted searches (its learned model
-    # predicts too many trains buckling: docs/cbst.md), so only the servo's plan is evaluated.
+    # Under the compliant controller the CBST cases pin one plan (blocks-2) and three exhausted
+    # searches (docs/cbst.md), so only the servo's blocks-4 plan is evaluated.
     if _servo:
         CASES[f"{_prefix}evaluate-blocks-4-cbst"] = _evaluation_case(
             "blocks-4", "cbst", 1, 0, _servo

@@ -24,7 +24,7 @@ How an example is drawn (``GenerationSettings`` holds every number):
   may be further out), narrowed so its contact is certain (``MIN_OVERLAP_PADDLE``); its
   shadow ``0.02 .. 0.5`` in
   behind the first block's shadow. The commanded reference puts the paddle's front, with
-  ``wall_push="uniform"`` (the default, and the data of every model shipped so far),
+  ``wall_push="uniform"`` (the default, and the data of the shipped servo model),
   uniformly between ``PUSH_MARGIN`` beyond the fully compressed train and the wall; with
   ``"wall"`` at the wall (the planner's push to a wall without ``compressed_wall_pushes``,
   :mod:`arrange_up.planning.actions`); with ``"planner"`` where CBST's push to the wall
@@ -96,6 +96,7 @@ __all__ = [
     "Dataset",
     "GenerationSettings",
     "ProgressCallback",
+    "SHIPPED_WALL_PUSH",
     "WALL_PUSHES",
     "generate_dataset",
     "generate_example",
@@ -118,6 +119,9 @@ COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
 SERVO = Controller(kind=ControllerKind.SERVO)
 #: The values of :attr:`GenerationSettings.wall_push`.
 WALL_PUSHES = ("uniform", "wall", "planner")
+#: The ``wall_push`` of each shipped model's data, by controller kind (docs/cbst.md): the
+#: compliant model learnt the planner's pushes to the wall, the servo's the uniform ones.
+SHIPPED_WALL_PUSH: dict[str, str] = {"compliant": "planner", "servo": "uniform"}
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from arrange_up.cbst.data import DEFAULT_GENERATION, WALL_PUSHES
+from arrange_up.cbst.data import DEFAULT_GENERATION, SHIPPED_WALL_PUSH, WALL_PUSHES
 from arrange_up.cbst.features import TARGET_NAMES, TARGET_UNITS
 from arrange_up.cbst.model import rescore_model
 from arrange_up.cbst.model import train_cbst as run_training
@@ -96,12 +96,12 @@ def _echo_scores(scores: dict) -> None:
 @click.option(
     "--wall-push",
     type=click.Choice(WALL_PUSHES),
-    default=DEFAULT_GENERATION.wall_push,
-    show_default=True,
+    default=None,
     help="Where each push sends the paddle: 'uniform' between just past the compressed train "
-    "and the wall (every shipped model's data), 'wall' at the wall, 'planner' where CBST's "
-    "push to the wall does (under compliant: past the compressed train by its worst-case "
-    "stall; docs/cbst.md).",
+    "and the wall, 'wall' at the wall, 'planner' where CBST's push to the wall does (under "
+    "compliant: past the compressed train by its worst-case stall; docs/cbst.md). "
+    "[default: the shipped model's of the controller: planner for compliant, uniform for "
+    "servo]",
 )
 @click.option(
     "--test-examples",
@@ -151,7 +151,7 @@ def train_cbst(
     examples: int,
     rollouts_per_example: int,
     controller: str,
-    wall_push: str,
+    wall_push: str | None,
     test_examples: int,
     test_seed: int,
     seed: int,
@@ -184,7 +184,9 @@ def train_cbst(
                 workers=workers,
                 output_dir=output_dir,
                 controller=Controller(kind=ControllerKind(controller)),
-                settings=replace(DEFAULT_GENERATION, wall_push=wall_push),
+                settings=replace(
+                    DEFAULT_GENERATION, wall_push=wall_push or SHIPPED_WALL_PUSH[controller]
+                ),
                 test_examples=test_examples,
                 test_seed=test_seed,
                 backend=backend,

@@ -13,7 +13,13 @@ from click.testing import CliRunner
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.cbst.choice import card_controller, controller_record, model_for
-from arrange_up.cbst.data import COMPLIANT, SERVO, GenerationSettings, generate_dataset
+from arrange_up.cbst.data import (
+    COMPLIANT,
+    SERVO,
+    SHIPPED_WALL_PUSH,
+    GenerationSettings,
+    generate_dataset,
+)
 from arrange_up.cbst.features import TARGET_NAMES
 from arrange_up.cbst.model import (
     SHIPPED_MODELS,
@@ -231,17 +237,20 @@ def test_a_model_of_the_planners_wall_pushes_predicts_those_pushes_only(tmp_path
     # Trained with wall_push="planner", a model knows the push that stops just past the
     # compressed train (the one CBST's planner offers) and no other: a push to the wall
     # itself is refused with TRAINED_PUSH_REFUSAL. A model of uniform pushes is not.
-    card = train_cbst(
-        examples=12,
-        rollouts_per_example=2,
-        seed=3,
-        workers=1,
-        output_dir=tmp_path,
-        settings=dataclasses.replace(GenerationSettings(), wall_push="planner"),
-        test_examples=3,
-        param_grid={"min_samples_leaf": [4]},
-        n_estimators=3,
-    )
+    def tiny(wall_push: str):
+        return train_cbst(
+            examples=12,
+            rollouts_per_example=2,
+            seed=3,
+            workers=1,
+            output_dir=tmp_path / wall_push,
+            settings=dataclasses.replace(GenerationSettings(), wall_push=wall_push),
+            test_examples=3,
+            param_grid={"min_samples_leaf": [4]},
+            n_estimators=3,
+        )
+
+    card = tiny("planner")
     assert card["data"]["settings"]["wall_push"] == "planner"
     problem = load("blocks-2")
     belief = IntervalBelief((("A", ObjectInterval((9.0, 0.912, 0.0), (0.1, 0.1, 0.1))),))
@@ -253,10 +262,21 @@ def test_a_model_of_the_planners_wall_pushes_predicts_those_pushes_only(tmp_path
         rightwards = [p for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2]
         return max(rightwards, key=lambda p: p.distance)  # the push to the wall
 
-    planner = CBSTSemantics(problem, model=tmp_path / "compliant.json")
+    planner = CBSTSemantics(problem, model=tmp_path / "planner" / "compliant.json")
     assert planner.apply(belief, wall_push(compressed=True)) is not None
     assert planner.apply(belief, wall_push(compressed=False)) is None
     assert planner.reasons == {TRAINED_PUSH_REFUSAL: 1}
-    uniform = CBSTSemantics(problem)  # the shipped model: uniform pushes
+    assert tiny("uniform")["data"]["settings"]["wall_push"] == "uniform"
+    uniform = CBSTSemantics(problem, model=tmp_path / "uniform" / "compliant.json")
     uniform.apply(belief, wall_push(compressed=False))
     assert TRAINED_PUSH_REFUSAL not in uniform.reasons
+
+
+def test_the_shipped_compliant_model_learnt_the_planners_wall_pushes():
+    # so that CBST's pushes to a wall under the default controller are the ones it predicts;
+    # train-cbst's default rule for each controller is its shipped model's
+    card = json.loads((model_dir() / "compliant.json").read_text())
+    assert card["data"]["settings"]["wall_push"] == SHIPPED_WALL_PUSH["compliant"] == "planner"
+    assert card["data"]["rollouts_per_example"] == 1000
+    servo = json.loads((model_dir() / "servo.json").read_text())
+    assert servo["data"]["settings"].get("wall_push", "uniform") == SHIPPED_WALL_PUSH["servo"]
