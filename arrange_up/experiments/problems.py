@@ -33,9 +33,23 @@ def controller_setting(problems: Mapping[str, ArrangementProblem]) -> str:
     return ",".join(sorted({problem.controller.kind.value for problem in problems.values()}))
 
 
+#: Settings added after CSVs were first recorded, with the value that turns them off: left out
+#: of the record when off, so that the rows of a controller whose physics they did not change
+#: (the servo has no stall window) still resume.
+_LATER_SETTINGS_OFF: dict[str, Any] = {"stall_window": 0.0}
+
+
 def physics_setting(problems: Mapping[str, ArrangementProblem]) -> dict[str, dict[str, Any]]:
     """The CSV setting naming the physics settings the problems are simulated with: for each
     controller kind among them, the default settings as that kind resolves them
-    (:meth:`~arrange_up.physics.settings.PhysicsSettings.for_controller`)."""
+    (:meth:`~arrange_up.physics.settings.PhysicsSettings.for_controller`), a setting added
+    later left out where it is off."""
     kinds = sorted({problem.controller.kind for problem in problems.values()}, key=str)
-    return {kind.value: dataclasses.asdict(DEFAULT_SETTINGS.for_controller(kind)) for kind in kinds}
+    record = {}
+    for kind in kinds:
+        values = dataclasses.asdict(DEFAULT_SETTINGS.for_controller(kind))
+        for name, off in _LATER_SETTINGS_OFF.items():
+            if values[name] == off:
+                del values[name]
+        record[kind.value] = values
+    return record

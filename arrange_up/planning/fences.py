@@ -52,7 +52,7 @@ the open are not offered while a fence on the table holds the part there (``face
 one can be put down that covers the part's centre across the push (as above). For a part that
 needs a fence along both axes any fence place will do (a corner: see *Levelling*).
 
-**Passing** (:meth:`Fences.passing`, :meth:`Fences.passing_aim`): a part that needs a fence
+**Passing** (:meth:`Fences.ahead`, :meth:`Fences.passing_aim`): a part that needs a fence
 along one axis only, and that no fence can press yet (it lies beyond every fence's reach
 across the push: a block above another, which must move along the row before it can come down
 to it), gets the open push towards its goal along that axis, but short of the fence still to
@@ -126,7 +126,8 @@ class FenceAhead:
     ``face``, the face of a fence on the table ahead that can press the part
     (:meth:`Fences.face_ahead`, ``None`` if none); ``fenced``, whether the pushes that end in
     the open give way to a fence (:meth:`Fences.replaces_open_pushes`); ``passing``, whether
-    they are passing pushes (:meth:`Fences.passing`)."""
+    they are *passing* pushes (module docstring, *Passing*: the part needs a fence along this
+    axis only, a fixture is still to be put down for it, and no fence can press it now)."""
 
     face: float | None = None
     fenced: bool = False
@@ -309,21 +310,6 @@ class Fences:
             and not fenced
         )
         return FenceAhead(face, fenced, passing)
-
-    def passing(
-        self,
-        part: str,
-        interval,
-        belief: IntervalBelief,
-        axis: int,
-        sign: int,
-        routes: dict[tuple[str, int, int], list[Place]],
-    ) -> bool:
-        """Whether the pushes of ``part`` along ``axis`` towards ``sign`` are *passing* ones
-        (module docstring, *Passing*): the part needs a fence along this axis only, a fixture
-        is still to be put down for it, and no fence can press it now
-        (:meth:`replaces_open_pushes`)."""
-        return self.ahead(part, interval, belief, axis, sign, routes).passing
 
     def passing_aim(self, part: str, interval, axis: int, sign: int) -> float:
         """The farthest coordinate along ``axis`` (towards ``sign``) a passing push takes

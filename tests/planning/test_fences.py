@@ -19,6 +19,7 @@ from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.io.yaml_problem import load_problem
 from arrange_up.model.problem import Uncertainty
 from arrange_up.model.world import Pick, Place, Push, WorldState
+from arrange_up.physics.stall import wall_overdrive, wall_push_front
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.transitions import make_semantics
 from arrange_up.transitions.cbst import FIXTURE_REFUSAL
@@ -187,7 +188,7 @@ def test_a_part_no_fence_can_press_yet_passes_towards_it_short_of_its_place():
     b = ("B", ObjectInterval((2.0, 4.5, 0.0), (0.3, 0.3, 0.09)))
     belief = IntervalBelief((a, b))
     routes = gen.fence_routes(belief)
-    assert ("B", 0, 1) in routes and gen.fences.passing("B", b[1], belief, 0, 1, routes)
+    assert ("B", 0, 1) in routes and gen.fences.ahead("B", b[1], belief, 0, 1, routes).passing
     aim = gen.fences.passing_aim("B", b[1], 0, 1)
     # B's shadow there (its depth at its angle spread, 0.54 in), widened by the free push's
     # end spread and one more push's noise, clears the bar's place shadow
@@ -212,7 +213,7 @@ def test_a_part_no_fence_can_press_yet_passes_towards_it_short_of_its_place():
     low = ("A", ObjectInterval((2.0, 0.55, 0.0), (0.3, 0.05, 0.09)))
     there = ("B", ObjectInterval((6.0, 0.55, 0.0), (0.3, 0.05, 0.09)))
     row = IntervalBelief((low, there))
-    assert not gen.fences.passing("B", there[1], row, 0, 1, gen.fence_routes(row))
+    assert not gen.fences.ahead("B", there[1], row, 0, 1, gen.fence_routes(row)).passing
     assert not [p for p in gen.pushes(row) if abs(p.pose[2] + math.pi / 2) < 1e-3 and p.pose[0] > 4]
 
 
@@ -276,11 +277,16 @@ def test_the_planner_builds_its_own_fence_and_its_plan_reaches_the_goal_in_rollo
 
 
 def test_cbst_takes_a_fence_for_the_wall_ahead_and_refuses_one_the_block_may_slip_past(corner):
-    # CBST's training domain needs the thesis's +-0.05 in push noise
+    # CBST's training domain needs the thesis's +-0.05 in push noise, and its model's
+    # pushes to a wall or fence were sent for the training's friction and density ranges
     problem = dataclasses.replace(
         corner,
         uncertainty=Uncertainty(
-            place=(0.03, 0.03, math.radians(2)), push=(0.05, 0.05, math.radians(3))
+            place=(0.03, 0.03, math.radians(2)),
+            push=(0.05, 0.05, math.radians(3)),
+            friction=(0.25, 0.55),
+            part_density=(0.1, 0.15),
+            manipulator_density=(0.35, 0.45),
         ),
     )
     semantics = make_semantics("cbst", problem)
@@ -291,15 +297,20 @@ def test_cbst_takes_a_fence_for_the_wall_ahead_and_refuses_one_the_block_may_sli
     bar = ("bar", ObjectInterval((6.65, 1.304473, 0.0), (0.03, 0.03, math.radians(2))))
     belief = IntervalBelief((block, bar))
     (push,) = [p for p in gen.pushes(belief) if abs(p.pose[2] + math.pi / 2) < 1e-3]
-    after = semantics.apply(belief, push).get("A")
-    # pressed against the bar's face (x = 6.5): A's centre at 6 within the face's own spread
-    # (0.03 in of place, 2 degrees over the bar's 2.5 in) and the model's dx and slop
+    # the push to the bar's face (x = 6.5) as CBST's planner sends it to a wall, and the
+    # shipped compliant model learnt it: the paddle's front past the compressed block by the
+    # wall overdrive
+    over = wall_overdrive(problem.controller, (0.25, 0.55), (0.1, 0.15), 1.0, 0.05)
+    front = push.pose[0] + 0.5 * 0.15
+    pressed = Push(push.manipulator, push.pose, wall_push_front(6.5, 1.0, over) - front)
+    after = semantics.apply(belief, pressed).get("A")
+    # pressed against the bar's face: A's centre at 6 within the face's own spread (0.03 in of
+    # place, 2 degrees over the bar's 2.5 in) and the model's dx and slop
     assert after.center[0] - after.half[0] < 6.0 < after.center[0] + after.half[0]
     assert after.half[0] < 0.15
     # the bar moved up: A's centre lies below its end, so A may slip past it
     high = ("bar", ObjectInterval((6.65, 2.3, 0.0), bar[1].half))
-    longer = Push(push.manipulator, push.pose, push.distance + 0.1)
-    assert semantics.apply(IntervalBelief((block, high)), longer) is None
+    assert semantics.apply(IntervalBelief((block, high)), pressed) is None
     assert semantics.reasons[FIXTURE_REFUSAL] == 1
 
 
