@@ -286,10 +286,10 @@ def convex_penetration(a: Sequence[Point] | np.ndarray, b: Sequence[Point] | np.
 
     In plain Python floats: the polygons have a few vertices, where numpy's per-call overhead
     would dominate (every push of the simulation tests its paddle's landing with it)."""
-    pa_ = a.tolist() if isinstance(a, np.ndarray) else [(float(x), float(y)) for x, y in a]
-    pb_ = b.tolist() if isinstance(b, np.ndarray) else [(float(x), float(y)) for x, y in b]
+    points_a = a.tolist() if isinstance(a, np.ndarray) else [(float(x), float(y)) for x, y in a]
+    points_b = b.tolist() if isinstance(b, np.ndarray) else [(float(x), float(y)) for x, y in b]
     best = math.inf
-    for poly in (pa_, pb_):
+    for poly in (points_a, points_b):
         n = len(poly)
         for i in range(n):
             x0, y0 = poly[i]
@@ -299,8 +299,8 @@ def convex_penetration(a: Sequence[Point] | np.ndarray, b: Sequence[Point] | np.
             if length <= 0.0:
                 continue
             nx, ny = nx / length, ny / length
-            on_a = [x * nx + y * ny for x, y in pa_]
-            on_b = [x * nx + y * ny for x, y in pb_]
+            on_a = [x * nx + y * ny for x, y in points_a]
+            on_b = [x * nx + y * ny for x, y in points_b]
             overlap = min(max(on_a), max(on_b)) - max(min(on_a), min(on_b))
             if overlap <= 0.0:
                 return 0.0
