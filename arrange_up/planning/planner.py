@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -122,6 +123,8 @@ class PlanResult:
     ``misses`` (None when solved) says how the belief of the smallest heuristic value the search
     reached still misses the goal (per part, the dimensions some particle is out of tolerance
     in); for ``unsolvable``, the parts that cannot fit on the table (``off table``).
+    ``refusals``: ``(reason, count)`` of the candidates the semantics refused, most frequent
+    first, for a semantics that says why (CBST's ``reasons``; empty otherwise).
     """
 
     status: SearchStatus
@@ -132,6 +135,7 @@ class PlanResult:
     statistics: PlanStatistics
     beliefs: tuple[Any, ...] | None = None
     misses: tuple[PartMiss, ...] | None = None
+    refusals: tuple[tuple[str, int], ...] = ()
 
     @property
     def solved(self) -> bool:
@@ -140,8 +144,9 @@ class PlanResult:
     @property
     def reason(self) -> str | None:
         """One line on why no plan was found (None when solved): the candidates refused by the
-        semantics (no prediction), pruned as dominated and by the ordering filter (an infinite
-        heuristic), and what the closest belief still misses."""
+        semantics (no prediction, with its two most frequent reasons where it gives them),
+        pruned as dominated and by the ordering filter (an infinite heuristic), and what the
+        closest belief still misses."""
         if self.solved:
             return None
         s = self.statistics
@@ -149,9 +154,14 @@ class PlanResult:
             parts = ", ".join(m.part for m in self.misses or ())
             return f"{parts} cannot fit on the table in any orientation: no plan exists"
         nodes = f"{s.expanded} node{'s' if s.expanded != 1 else ''}"
+        why = "no prediction"
+        if self.refusals:
+            why += "; most often: " + ", ".join(
+                f"{count} {reason}" for reason, count in self.refusals[:2]
+            )
         line = (
             f"{self.status} after {nodes}: {s.no_prediction} candidates refused by the semantics "
-            f"(no prediction), {s.pruned_dominated} pruned as dominated, {s.pruned_infinite} by "
+            f"({why}), {s.pruned_dominated} pruned as dominated, {s.pruned_infinite} by "
             "the ordering filter"
         )
         if self.misses:
@@ -362,6 +372,7 @@ def plan(
         statistics=statistics,
         beliefs=tuple(result.states) if result.states is not None else None,
         misses=_misses(task, result, oversized),
+        refusals=tuple(getattr(task.semantics, "reasons", Counter()).most_common()),
     )
 
 

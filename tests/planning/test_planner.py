@@ -230,6 +230,17 @@ def test_a_search_that_runs_out_of_candidates_is_exhausted_and_says_why():
     assert stats.pruned_dominated > 0
 
 
+def test_an_exhausted_cbst_search_names_its_most_frequent_refusals():
+    result = plan(load("blocks-4"), semantics="cbst", workers=1)
+    assert result.status is SearchStatus.EXHAUSTED
+    counts = [count for _, count in result.refusals]
+    assert counts == sorted(counts, reverse=True)
+    assert sum(counts) == result.statistics.no_prediction  # every refusal has its reason
+    (first, n1), (second, n2) = result.refusals[:2]
+    assert f"(no prediction; most often: {n1} {first}, {n2} {second})" in result.reason
+    assert plan(servo(tiny("obstacle")), particles=5, workers=1).refusals == ()
+
+
 def test_a_goal_part_larger_than_the_table_is_proven_unsolvable_before_searching():
     problem, diagnostics = check_problem_text(TOO_LARGE, "too-large")
     assert problem is not None and [d.severity for d in diagnostics] == ["warning"]
