@@ -140,7 +140,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arrange_up.belief.states import IntervalBelief, wrap_angle
+from arrange_up.belief.states import IntervalBelief, symmetry_period, wrap_angle
 from arrange_up.geometry.boxes import box_row
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import (
@@ -179,6 +179,11 @@ LADDER = (0.5, 1.0, 2.0)
 #: Parts ahead of a pushed part within this gap (in) count as moved with it by the push, for
 #: the compliant controller's stall.
 CONTACT_GAP = 0.1
+#: Turning pushes (a part turned away from its goal angle): the manipulator's centre shifted
+#: across the push from the part's centre by this fraction of the manipulator's length, to
+#: either side, so that it presses one side of the part and turns it (docs/design/planning.md,
+#: "Turning pushes").
+TURN_OFFSET = 0.3
 #: Under the compliant controller: simulations per candidate push spent solving for its
 #: distance, and the error in the part's travel (in) at which the solver stops.
 SOLVER_STEPS = 3
@@ -504,6 +509,7 @@ class ActionGenerator:
             name, interval, belief, axis, sign, front_nominal, ladder, routes, detour, away, fence
         )
         pushes = []
+        turning = self._turned_away(name, interval, belief)
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
             # Clear of the obstacles the paddle would sweep into where its approach shadow can
             # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
@@ -527,12 +533,15 @@ class ActionGenerator:
                 centres = self._clear_of_fences(
                     manip, name, interval, belief, axis, sign, along, m_box, centres, group
                 )
-            for across in centres:
+            turns = self._turning_centres(manip, interval, axis, m_box, centres) if turning else []
+            for across in centres + turns:
                 pose = (along, across, theta) if axis == 0 else (across, along, theta)
                 if self.checker.shadow_clear(
                     manip.spec.name, pose, self.push_unc, on_table, [box for _, box in boxes]
                 ):
                     for d, travel in group:
+                        if travel is not None and across in turns:
+                            continue  # a turning push presses the part against what stops it
                         push = Push(manip.spec.name, _clean(pose), round(float(d), 4))
                         if self.stall_per_area and self.solve_distances and travel is not None:
                             distance = self._solve_distance(push, name, axis, sign, travel, belief)
@@ -541,6 +550,39 @@ class ActionGenerator:
                         if d in jammed and jams is not None:
                             jams.append(push)
         return pushes
+
+    def _turned_away(self, name: str, interval, belief: IntervalBelief) -> bool:
+        """Whether part ``name``'s belief is centred on an angle outside its goal angle's
+        tolerance (the difference taken modulo the part's symmetry period, as the goal test
+        does). A belief only wider than the tolerance is not: pressing it against a wall
+        narrows it, and pushes on one side offered for it made worse plans (wide-paddle-row)."""
+        target = self.place_target(name, belief)
+        if target is None:
+            return False
+        period = symmetry_period(self.problem.object(name).shape)
+        tolerance = self.problem.goal.tolerance[2]
+        if tolerance is None or tolerance >= 0.5 * period:
+            return False  # any angle will do
+        off = (interval.center[2] - target[2] + 0.5 * period) % period - 0.5 * period
+        return abs(off) > tolerance + 1e-9
+
+    def _turning_centres(self, manip, interval, axis: int, m_box, centres) -> list[float]:
+        """Turning pushes: centres across the push shifted from the part's centre by
+        :data:`TURN_OFFSET` of the manipulator's length to either side (within the span at
+        which it still covers the part's centre and clears the walls), so that it presses one
+        side of a part turned away from its goal angle and turns it flat against the wall,
+        fence or obstacle it is pressed against (only the distances that press a part are
+        offered with them: a free push on one side leaves the angle to chance); those not
+        already in ``centres``. The approach's clearance is checked with every other centre's."""
+        other = 1 - axis
+        low, high = self._across_span(manip, interval, other, m_box)
+        shift = TURN_OFFSET * manip.length
+        found = []
+        for side in (-1.0, 1.0):
+            value = interval.center[other] + side * shift
+            if low <= value <= high and all(abs(value - c) > 1e-6 for c in (*centres, *found)):
+                found.append(value)
+        return found
 
     def _clear_of_fences(
         self, manip, name, interval, belief, axis, sign, along, m_box, centres, distances
