@@ -509,7 +509,9 @@ class ActionGenerator:
             name, interval, belief, axis, sign, front_nominal, ladder, routes, detour, away, fence
         )
         pushes = []
-        turning = self._turned_away(name, interval, belief)
+        turning = self._turned_away(name, interval, belief) or (
+            bool(self.mates) and self.mates.square(name, interval.half)
+        )
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
             # Clear of the obstacles the paddle would sweep into where its approach shadow can
             # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
@@ -828,6 +830,12 @@ class ActionGenerator:
             gather = self.mates.gather(name, interval.half[axis], axis)
             if gather is not None:
                 travels.setdefault(gap + gather + stall, gather)
+            if wall in self.problem.table.walls and self.mates.square(name, interval.half):
+                # squared: pressed against the wall ahead, its turned states turn flat
+                boundary = size if sign > 0 else 0.0
+                press = self._stop_front(sign * boundary, (name,), belief, axis) - front
+                travels.setdefault(press, None)
+                squeezes.add(press)
             if ladder and not candidates and not self.push_distances:
                 # A short ladder of travels, those that keep the part's nominal footprint on
                 # the table.

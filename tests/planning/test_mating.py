@@ -4,7 +4,9 @@ offers for them: brought beside the mate with clearance, then seated against it.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
+import numpy as np
 import pytest
 from catalogue import servo
 
@@ -12,10 +14,11 @@ import arrange_up
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.io.yaml_problem import load_problem_text
+from arrange_up.io.yaml_problem import load_problem, load_problem_text
 from arrange_up.physics.stall import wall_overdrive
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.planning.mating import Mates
+from arrange_up.planning.task import BeliefTask
 
 #: B's goal: flush against A's right face (A is the reference).
 PAIR = """
@@ -152,3 +155,37 @@ def test_create_a_t_is_planned_by_gathering_its_top_bar():
         for a, b in zip(result.beliefs, result.beliefs[1:], strict=False)
     ]
     assert any(moved_top)
+
+
+def test_a_turned_reference_whose_angle_spread_moves_its_mates_targets_is_squared():
+    # m-rotated-reference-pair: the bar R starts turned 30 degrees +-5; at 8.5 cm its mates'
+    # targets move +-7.4 mm with that spread, which with R's own +-5 mm exceeds the +-8 mm
+    # tolerance (its position spread alone would not).
+    path = (
+        Path(__file__).resolve().parents[1] / "problems" / "fresh" / "m-rotated-reference-pair.yaml"
+    )
+    problem = load_problem(path)
+    mates = Mates(problem)
+    mm = 1.0 / 25.4
+    assert mates.square("R", (5 * mm, 5 * mm, math.radians(5)))
+    assert not mates.square("R", (5 * mm, 5 * mm, math.radians(0.5)))
+    assert not mates.square("R", (9 * mm, 5 * mm, math.radians(5)))  # gathering's case
+    assert not mates.square("A", (5 * mm, 5 * mm, math.radians(5)))
+    task = BeliefTask.build(
+        problem,
+        semantics="particles",
+        particles=10,
+        seed=0,
+        workers=1,
+        heuristic="inadmissible",
+        dominance=True,
+        variety=False,
+    )
+    squared = []
+    for edge in task.successors(task.initial_belief()):
+        child = edge.make_child()
+        if child is not None:
+            theta = child.poses[:, child.names().index("R"), 2]
+            squared.append(float(np.abs(theta).max()))
+    # a press on one side against a wall turns it flat in every particle
+    assert min(squared) < math.radians(3)
