@@ -25,6 +25,15 @@ contacts certain where CBST must refuse a clipped one (a row of blocks built aga
 where each new block's push down clips the block beside it). Particle semantics simulate
 clipped contacts, and for them the extra pushes only widen the search, so it is off by default
 (the cases that motivate both positions are in docs/design/planning.md).
+
+**Turning pushes**: a part whose belief is centred on an angle outside its goal's tolerance
+(modulo its symmetry period), and a relative goal's reference that
+:meth:`~arrange_up.planning.mating.Mates.square` says to square, are also offered their pushes
+that press them against what stops them (the distances below with no part travel of their
+own) with the manipulator shifted across by ``TURN_OFFSET`` of its length to either side: it
+presses one side, and the part turns until its face lies flat against the wall (a centred
+push leaves a turned part resting on two corners, still turned).
+
 Distances:
 
 * to the wall ahead (the controller stalls when the train of parts is compressed against it),
@@ -54,6 +63,9 @@ Distances:
   than the goal tolerance, a push that moves its centre by its half-width, so that every
   state is swept to the far edge of the interval (the parts placed relative to it inherit
   its spread, and it has no goal position to narrow it to);
+* **squaring** the reference of a relative goal: to the wall ahead (as a press, compressed
+  like a wall push), where :meth:`~arrange_up.planning.mating.Mates.square` says its angle
+  spread takes its mates' targets beyond the tolerance;
 * **a ladder** of travels (``LADDER``) for a part without a goal position of its own (the
   reference of a relative goal), keeping its nominal footprint on the table, offered only
   while some goal part cannot be placed at all (the reference may have to make room);
@@ -556,8 +568,8 @@ class ActionGenerator:
     def _turned_away(self, name: str, interval, belief: IntervalBelief) -> bool:
         """Whether part ``name``'s belief is centred on an angle outside its goal angle's
         tolerance (the difference taken modulo the part's symmetry period, as the goal test
-        does). A belief only wider than the tolerance is not: pressing it against a wall
-        narrows it, and pushes on one side offered for it made worse plans (wide-paddle-row)."""
+        does). A belief only wider than the tolerance is not: pressing it against a wall with
+        the centred pushes narrows it."""
         target = self.place_target(name, belief)
         if target is None:
             return False
