@@ -241,6 +241,7 @@ class ActionGenerator:
         self.compliant = problem.controller.kind is ControllerKind.COMPLIANT
         self.stall_per_area = stall_per_area(problem)
         self.areas = {spec.name: spec.shape.area for spec in problem.parts}
+        self.periods = {spec.name: symmetry_period(spec.shape) for spec in problem.parts}
         self.wall_trains = self._wall_trains()
         self._limits = (self._across_limits(0), self._across_limits(1))
         walls = set(problem.table.walls)
@@ -404,6 +405,9 @@ class ActionGenerator:
                 if interval is None:
                     continue
                 detours = self._detours(spec.name, interval, belief) if self.obstacles else {}
+                turning = self._turned_away(spec.name, interval, belief) or (
+                    bool(self.mates) and self.mates.square(spec.name, interval.half)
+                )
                 jams: list[Push] = []
                 mine: list[Push] = []
                 detoured = False
@@ -420,6 +424,7 @@ class ActionGenerator:
                         routes,
                         detours.get(direction),
                         jams,
+                        turning,
                     )
                     detoured = detoured or (direction in detours and bool(pushes))
                     mine.extend(pushes)
@@ -486,11 +491,13 @@ class ActionGenerator:
         routes=None,
         detour: float | None = None,
         jams: list[Push] | None = None,
+        turning: bool = False,
     ) -> list[Push]:
         """The pushes of part ``name`` along ``direction``; ``on_table`` are the belief's
         shadows ``(name, centre, half)`` and ``boxes`` their ``(name, shadow box)``. Those that
         would drive a state of the part into an obstacle (:meth:`_cut_short`) are also appended
-        to ``jams``."""
+        to ``jams``. ``turning``: the part is also offered turning pushes (the module
+        docstring; decided once per part by :meth:`pushes`)."""
         ux, uy = DIRECTIONS[direction]
         axis = 0 if ux else 1
         sign = int(ux + uy)  # +1 or -1
@@ -521,9 +528,6 @@ class ActionGenerator:
             name, interval, belief, axis, sign, front_nominal, ladder, routes, detour, away, fence
         )
         pushes = []
-        turning = self._turned_away(name, interval, belief) or (
-            bool(self.mates) and self.mates.square(name, interval.half)
-        )
         for sweep, group in self._sweeps(distances, along, m_box, part_box, axis, sign):
             # Clear of the obstacles the paddle would sweep into where its approach shadow can
             # be; else where the nominal paddle can (the obstacles' boxes shrunk by the margin
@@ -573,11 +577,11 @@ class ActionGenerator:
         target = self.place_target(name, belief)
         if target is None:
             return False
-        period = symmetry_period(self.problem.object(name).shape)
+        period = self.periods[name]
         tolerance = self.problem.goal.tolerance[2]
         if tolerance is None or tolerance >= 0.5 * period:
             return False  # any angle will do
-        off = (interval.center[2] - target[2] + 0.5 * period) % period - 0.5 * period
+        off = wrap_angle(interval.center[2], target[2], period) - target[2]
         return abs(off) > tolerance + 1e-9
 
     def _turning_centres(self, manip, interval, axis: int, m_box, centres) -> list[float]:
