@@ -10,15 +10,20 @@ From a test, either take the fixtures of ``tests/conftest.py`` (``tiny`` is :fun
 (``from catalogue import tiny``): pytest puts ``tests/`` on the path for its ``conftest.py``.
 
 Problems are frozen dataclasses, so one loaded problem is shared by every test that asks for it.
+:func:`particle_task` builds the search task the planner would for a problem, for tests of the
+candidates and beliefs it sees.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import cache
 
 from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.problem import SERVO_CONTROLLER, ArrangementProblem
+from arrange_up.planning.task import BeliefTask
 
 TEXTS: dict[str, str] = {
     # One block to the lower-right corner of a small walled board; starts off the table.
@@ -188,6 +193,28 @@ def servo(problem: ArrangementProblem) -> ArrangementProblem:
     """``problem`` driven by the servo: for tests of rules stated for a push that ends where it
     was sent (the default compliant controller stops short: tests/planning/test_stall_aware.py)."""
     return dataclasses.replace(problem, controller=SERVO_CONTROLLER)
+
+
+@contextmanager
+def particle_task(
+    problem: ArrangementProblem, particles: int, seed: int = 0
+) -> Iterator[BeliefTask]:
+    """The search task ``plan(problem, particles=particles, seed=seed, workers=1)`` builds
+    (particle semantics, the inadmissible heuristic, dominance, no variety), closed on leaving."""
+    task = BeliefTask.build(
+        problem,
+        semantics="particles",
+        particles=particles,
+        seed=seed,
+        workers=1,
+        heuristic="inadmissible",
+        dominance=True,
+        variety=False,
+    )
+    try:
+        yield task
+    finally:
+        task.close()
 
 
 def _load(yaml_text: str, source: str) -> ArrangementProblem:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from catalogue import servo
+from catalogue import particle_task, servo
 
 import arrange_up
 from arrange_up.belief.goals import GoalTest
@@ -18,7 +18,6 @@ from arrange_up.io.yaml_problem import load_problem, load_problem_text
 from arrange_up.physics.stall import wall_overdrive
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.planning.mating import Mates
-from arrange_up.planning.task import BeliefTask
 
 #: B's goal: flush against A's right face (A is the reference).
 PAIR = """
@@ -171,21 +170,12 @@ def test_a_turned_reference_whose_angle_spread_moves_its_mates_targets_is_square
     assert not mates.square("R", (5 * mm, 5 * mm, math.radians(0.5)))
     assert not mates.square("R", (9 * mm, 5 * mm, math.radians(5)))  # gathering's case
     assert not mates.square("A", (5 * mm, 5 * mm, math.radians(5)))
-    task = BeliefTask.build(
-        problem,
-        semantics="particles",
-        particles=10,
-        seed=0,
-        workers=1,
-        heuristic="inadmissible",
-        dominance=True,
-        variety=False,
-    )
     squared = []
-    for edge in task.successors(task.initial_belief()):
-        child = edge.make_child()
-        if child is not None:
-            theta = child.poses[:, child.names().index("R"), 2]
-            squared.append(float(np.abs(theta).max()))
+    with particle_task(problem, 10) as task:
+        for edge in task.successors(task.initial_belief()):
+            child = edge.make_child()
+            if child is not None:
+                theta = child.poses[:, child.names().index("R"), 2]
+                squared.append(float(np.abs(theta).max()))
     # a press on one side against a wall turns it flat in every particle
     assert min(squared) < math.radians(3)
