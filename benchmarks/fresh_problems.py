@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/fresh_problems.py [--particles 20] [--semantics particles]
+    python benchmarks/fresh_problems.py [--particles 20] [--semantics particles] [--validate V]
         [--timeout 300] [--rollouts 200] [--problems tests/problems/fresh/*.yaml]
         [--output fresh.csv]
 
@@ -15,9 +15,11 @@ against one); four with a fixed post: on the straight line to the goal in the op
 wall between a block lying on that wall and its goal, just beyond the goal, and flush with the
 goal; and eight written blind by an outsider to the planner, in other units, shapes, walls and
 paddles, four with relative goals), plans as ``arrange-up plan FILE --particles N --semantics
-S`` does (seed 0, one worker), then evaluates a found plan with ``--rollouts`` noisy rollouts
-(seed 0) and prints a row: status, nodes expanded, planning seconds, plan length, successes,
-and the planner's reason when no plan was found. Each row is appended to the CSV (if given) as
+S [--validate V]`` does (seed 0, one worker), then evaluates a found plan with ``--rollouts``
+noisy rollouts (seed 0) and prints a row: status, nodes expanded (of the search whose plan was
+returned), planning seconds (validation and every search included), plan length, the planner's
+validation rollouts, searches and validation successes, successes of the evaluation, and the
+planner's reason when no plan was found. Each row is appended to the CSV (if given) as
 soon as it is measured.
 """
 
@@ -42,6 +44,9 @@ FIELDS = [
     "expanded",
     "seconds",
     "plan_length",
+    "validate",
+    "searches",
+    "validated",
     "rollouts",
     "successes",
     "reason",
@@ -49,13 +54,25 @@ FIELDS = [
 
 
 def measure(
-    path: Path, particles: int, timeout: float, rollouts: int, semantics: str = "particles"
+    path: Path,
+    particles: int,
+    timeout: float,
+    rollouts: int,
+    semantics: str = "particles",
+    validate: int | None = None,
 ) -> dict[str, object]:
     problem = load_problem(path)
     started = time.perf_counter()
     result = plan(
-        problem, semantics=semantics, particles=particles, seed=0, workers=1, timeout=timeout
+        problem,
+        semantics=semantics,
+        particles=particles,
+        seed=0,
+        workers=1,
+        timeout=timeout,
+        validate=validate,
     )
+    validation = result.validation
     seconds = time.perf_counter() - started
     row: dict[str, object] = {
         "problem": problem.name,
@@ -66,6 +83,9 @@ def measure(
         "expanded": result.stats["expanded"],
         "seconds": round(seconds, 1),
         "plan_length": len(result.actions) if result.actions else "",
+        "validate": validation.rollouts if validation else 0,
+        "searches": len(validation.rounds) if validation else 1,
+        "validated": validation.successes if validation else "",
         "rollouts": "",
         "successes": "",
         "reason": result.reason or "",
@@ -83,6 +103,12 @@ def main() -> None:
     parser.add_argument("--semantics", default="particles", help="deterministic, particles, ...")
     parser.add_argument("--timeout", type=float, default=300.0, help="planning seconds")
     parser.add_argument("--rollouts", type=int, default=200)
+    parser.add_argument(
+        "--validate",
+        type=int,
+        default=None,
+        help="the planner's validation rollouts (default: its own, twice the particles; 0 off)",
+    )
     parser.add_argument("--output", type=Path, default=None)
     args = parser.parse_args()
     paths = args.problems or sorted(FRESH.glob("*.yaml"))
@@ -96,7 +122,9 @@ def main() -> None:
             writer.writeheader()
     try:
         for path in paths:
-            row = measure(path, args.particles, args.timeout, args.rollouts, args.semantics)
+            row = measure(
+                path, args.particles, args.timeout, args.rollouts, args.semantics, args.validate
+            )
             print(" ".join(f"{k}={row[k]}" for k in FIELDS if row[k] != ""), flush=True)
             if writer is not None and handle is not None:
                 writer.writerow(row)

@@ -60,29 +60,40 @@ def _load(name: str, servo: bool):
 
 
 def _plan_case(
-    name: str, semantics: str, particles: int, seed: int, servo: bool
+    name: str, semantics: str, particles: int, seed: int, servo: bool, validate: int | None = 0
 ) -> Callable[[], Any]:
+    """A planning case; ``validate`` as for :func:`arrange_up.plan` (0: one search, unchecked)."""
+
     def case() -> Any:
         result = arrange_up.plan(
-            _load(name, servo), semantics=semantics, particles=particles, seed=seed
+            _load(name, servo),
+            semantics=semantics,
+            particles=particles,
+            seed=seed,
+            validate=validate,
         )
-        return {
+        data = {
             "status": plain(result.status),
             "actions": plain(result.actions),
             "semantics": result.semantics,
             "particles": result.particles,
             "stats": plain(result.stats),
         }
+        if result.validation is not None:
+            data["validation"] = plain(result.validation)
+        return data
 
     return case
 
 
 def _evaluation_case(
-    name: str, semantics: str, particles: int, seed: int, servo: bool
+    name: str, semantics: str, particles: int, seed: int, servo: bool, validate: int | None = 0
 ) -> Callable[[], Any]:
     def case() -> Any:
         problem = _load(name, servo)
-        result = arrange_up.plan(problem, semantics=semantics, particles=particles, seed=seed)
+        result = arrange_up.plan(
+            problem, semantics=semantics, particles=particles, seed=seed, validate=validate
+        )
         reliability = evaluate_plan(problem, result.actions, rollouts=200, seed=0, workers=1)
         data = plain(reliability.to_json())
         for key in ("backend", "workers", "resumed"):  # how the run was made, not its result
@@ -136,6 +147,14 @@ for _servo, _prefix in ((False, ""), (True, "servo-")):
             "blocks-4", "cbst", 1, 0, _servo
         )
     CASES[f"{_prefix}repair-tz-mating-p10"] = _repair_case("tz-mating", 10, _servo)
+    # Validated particle plans (the planner's default since validation was added; the cases
+    # above pin the single search, which validate=0 still selects).
+    CASES[f"{_prefix}validated-blocks-4-p10-s0"] = _plan_case(
+        "blocks-4", "particles", 10, 0, _servo, validate=None
+    )
+    CASES[f"{_prefix}evaluate-validated-blocks-4-p10-s0"] = _evaluation_case(
+        "blocks-4", "particles", 10, 0, _servo, validate=None
+    )
 
 
 def golden_path(case: str) -> Path:

@@ -102,6 +102,16 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     help="Weighted A*: f = g + weight * h (1 = A*).",
 )
 @click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
+@click.option(
+    "--validate",
+    type=click.IntRange(0, None),
+    default=None,
+    help="Particle semantics: check a found plan on this many fresh rollouts (new initial "
+    "states and noise, judged as evaluate judges them); when some fail, search again with "
+    "their initial states added to the particles, up to 3 more times, and return the plan "
+    "that did best. 0 turns it off. [default: twice --particles, at least 40; off for other "
+    "semantics]",
+)
 @parallel_options("simulations of the successors the search will evaluate next")
 @click.option(
     "--model",
@@ -128,6 +138,7 @@ def plan(
     heuristic: str,
     weight: float,
     no_dominance: bool,
+    validate: int | None,
     workers: int | None,
     backend: str | None,
     scheduler: str | None,
@@ -149,11 +160,18 @@ def plan(
     plans). --workers defaults to all cores (1 for the deterministic semantics). The cbst
     semantics predicts in this process: it starts no workers or cluster.
 
+    A particle plan is conformant for its particles only, so it is checked on twice --particles
+    fresh rollouts, at least 40 (--validate); their failed starts become further particles of up
+    to three more searches, and the line after the statistics says how the returned plan did.
+    The rollouts are seeded apart from evaluate's, which stays a fresh test.
+
     Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted: the
     candidates ran out, unsolvable: proven, e.g. a goal part larger than the table), 2 bad
     input. An unsolved run prints one line of why.
     """
     check_semantics(semantics)
+    if validate and semantics != "particles":
+        fail(f"--validate checks particle plans; --semantics {semantics} takes none")
     backend = backend_choice(backend, scheduler)
     loaded = load_problem(problem)
     if semantics == "cbst":
@@ -184,6 +202,7 @@ def plan(
                 scheduler=scheduler,
                 progress=update,
                 model=model,
+                validate=validate,
             )
     except BackendUnavailableError as error:  # dask missing, or the scheduler unreachable
         fail(f"--backend {backend}: {error}")
@@ -200,7 +219,11 @@ def plan(
         semantics=result.semantics,
         seed=seed,
         search=result.stats,
-        extra={"particles": result.particles, **({"model": model} if model else {})},
+        extra={
+            "particles": result.particles,
+            **({"model": model} if model else {}),
+            **({"validation": result.validation.to_json()} if result.validation else {}),
+        },
     )
     if output:
         write_json_atomic(Path(output), document)
@@ -218,6 +241,8 @@ def plan(
         )
         if result.reason is not None:
             click.echo(result.reason)
+        if result.validation is not None:
+            click.echo(result.validation.line())
         if result.actions is not None:
             click.echo(actions_table(loaded, result.actions))
         if output:

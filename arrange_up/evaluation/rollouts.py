@@ -71,6 +71,7 @@ __all__ = [
     "Step",
     "check_landing",
     "execute_plan",
+    "rollout_start",
     "rollout_task",
     "simulate_rollout",
     "trace_rollout",
@@ -146,7 +147,7 @@ class Rollouts:
         """Rollout ``index`` of an evaluation with ``seed``; the states it passes through are
         appended to ``trace`` when given (as :attr:`Execution.states`)."""
         rng = np.random.default_rng([seed, index])
-        state = sample_initial_particles(self.problem, 1, rng, frame=self.frame).particles[0]
+        state = _draw_start(self.problem, rng, self.frame)
         states = [] if trace is None else trace
         states.append(state)
         state, failure = self._execute(state, rng, states)
@@ -256,6 +257,20 @@ def execute_plan(
     """Execute ``actions`` from ``state`` as a rollout does (noise drawn from ``rng`` per
     action, the same failures), without sampling the start or testing the goal."""
     return Rollouts(problem, actions, settings, landing).execute(state, rng)
+
+
+def _draw_start(
+    problem: ArrangementProblem, rng: np.random.Generator, frame: AngleFrame
+) -> WorldState:
+    """Step 1 of a rollout: its initial state, the first draws of its generator."""
+    return sample_initial_particles(problem, 1, rng, frame=frame).particles[0]
+
+
+def rollout_start(problem: ArrangementProblem, seed: int, index: int) -> WorldState:
+    """The initial state rollout ``index`` of an evaluation with ``seed`` starts from (the state
+    :func:`trace_rollout` begins with), drawn without running the rollout."""
+    rng = np.random.default_rng([seed, index])
+    return _draw_start(problem, rng, AngleFrame.of(problem))
 
 
 def simulate_rollout(

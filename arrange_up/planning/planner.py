@@ -8,6 +8,7 @@ status.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections import Counter
@@ -19,12 +20,20 @@ from typing import Any
 import numpy as np
 
 from arrange_up.belief.goals import PartMiss
+from arrange_up.belief.states import ParticleBelief
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.model.world import Action
+from arrange_up.model.world import Action, WorldState
 from arrange_up.parallel import Runner, SerialRunner, check_runner_options, get_runner
 from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
+from arrange_up.planning.validation import (
+    VALIDATION_REPLANS,
+    Validation,
+    ValidationRound,
+    default_validation_rollouts,
+    validate_plan,
+)
 from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_first_search
 
 __all__ = [
@@ -125,6 +134,11 @@ class PlanResult:
     in); for ``unsolvable``, the parts that cannot fit on the table (``off table``).
     ``refusals``: ``(reason, count)`` of the candidates the semantics refused, most frequent
     first, for a semantics that says why (CBST's ``reasons``; empty otherwise).
+    ``validation`` (None when the plan was not validated): how the plan, and each search, did
+    on fresh rollouts (the ``validate`` argument of :func:`plan`). Of a validated run,
+    ``statistics`` are those of the search whose plan is returned, but ``elapsed`` is the
+    whole call's, and ``beliefs`` start from that search's particles (the requested ones and
+    the counterexamples added before it).
     """
 
     status: SearchStatus
@@ -136,6 +150,7 @@ class PlanResult:
     beliefs: tuple[Any, ...] | None = None
     misses: tuple[PartMiss, ...] | None = None
     refusals: tuple[tuple[str, int], ...] = ()
+    validation: Validation | None = None
 
     @property
     def solved(self) -> bool:
@@ -222,6 +237,7 @@ def plan(
     should_stop: Callable[[], bool] | None = None,
     model: str | Path | None = None,
     start: Any = None,
+    validate: int | None = None,
 ) -> PlanResult:
     """Search for a conformant plan for ``problem``.
 
@@ -290,7 +306,119 @@ def plan(
         and ``deterministic`` (any particle count; one particle plans for that state alone), an
         :class:`~arrange_up.belief.states.IntervalBelief` for ``cbst``. Closed-loop execution
         replans from its posterior this way (:mod:`arrange_up.execution.replanning`).
+    validate
+        Rollouts that check a plan the ``particles`` semantics found on fresh initial states and
+        noise (:mod:`arrange_up.planning.validation`); when some fail, their initial states join
+        the search's particles (at most ``particles`` of them per round) and the search runs again,
+        at most :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while
+        ``timeout`` leaves time. The plan returned is the one that succeeded in most validation
+        rollouts, and :attr:`PlanResult.validation` says how each search did. ``None`` (default):
+        twice ``particles``, at least 40, for the ``particles`` semantics planning from the
+        problem's initial belief, else 0 (off); 0 turns it off. Other semantics, and a ``start``
+        belief (a posterior, not the problem's initial uncertainty), take no validation: a positive
+        value for them raises ``ValueError``.
     """
+    if validate is None:
+        validate = default_validation_rollouts(particles) if semantics == "particles" else 0
+        validate = validate if start is None else 0
+    if validate < 0:
+        raise ValueError(f"validate must be a non-negative integer, got {validate!r}")
+    if validate and (semantics != "particles" or start is not None):
+        raise ValueError(
+            "validate applies to the particles semantics planning from the problem's initial "
+            f"belief, not to {semantics!r}" + (" with a start belief" if start is not None else "")
+        )
+    started = time.monotonic()
+
+    def search(start: Any, particles: int) -> PlanResult:
+        left = None if timeout is None else max(0.0, timeout - (time.monotonic() - started))
+        return _search(
+            problem,
+            semantics=semantics,
+            particles=particles,
+            seed=seed,
+            max_nodes=max_nodes,
+            timeout=left,
+            heuristic=heuristic,
+            dominance=dominance,
+            weight=weight,
+            deferred=deferred,
+            workers=workers,
+            backend=backend,
+            scheduler=scheduler,
+            tie_break=tie_break,
+            variety=variety,
+            progress=progress,
+            should_stop=should_stop,
+            model=model,
+            start=start,
+        )
+
+    result = search(start, particles)
+    if not validate or not result.solved:
+        return result
+    found: list[PlanResult] = []
+    rounds: list[ValidationRound] = []
+    failed: tuple[WorldState, ...] = ()
+    for round_ in range(VALIDATION_REPLANS + 1):
+        if round_:
+            belief = found[-1].beliefs[0]  # type: ignore[index]  # a solved search's start
+            belief = ParticleBelief(belief.particles + failed[:particles])
+            result = search(belief, len(belief.poses))
+        size = len(result.beliefs[0].poses) if result.beliefs else particles
+        if not result.solved:
+            rounds.append(ValidationRound(size, result.status, result.stats["expanded"], None))
+            break
+        successes, failed = validate_plan(
+            problem,
+            result.actions,  # type: ignore[arg-type]  # set when solved
+            rollouts=validate,
+            seed=seed,
+            round_=round_,
+            workers=workers,
+            backend=backend,
+            scheduler=scheduler,
+        )
+        rounds.append(ValidationRound(size, result.status, result.stats["expanded"], successes))
+        found.append(result)
+        out_of_time = timeout is not None and time.monotonic() - started >= timeout
+        if not failed or out_of_time or (should_stop is not None and should_stop()):
+            break
+    planned = [i for i, r in enumerate(rounds) if r.successes is not None]
+    chosen = max(planned, key=lambda i: (rounds[i].successes, i))
+    best = found[planned.index(chosen)]
+    statistics = dataclasses.replace(best.statistics, elapsed=time.monotonic() - started)
+    return dataclasses.replace(
+        best,
+        particles=particles,
+        statistics=statistics,
+        validation=Validation(validate, tuple(rounds), chosen),
+    )
+
+
+def _search(
+    problem: ArrangementProblem,
+    *,
+    semantics: str,
+    particles: int,
+    seed: int,
+    max_nodes: int | None,
+    timeout: float | None,
+    heuristic: str,
+    dominance: bool,
+    weight: float,
+    deferred: bool,
+    workers: int,
+    backend: str,
+    scheduler: str | None,
+    tie_break: bool,
+    variety: bool,
+    progress: ProgressCallback | None,
+    should_stop: Callable[[], bool] | None,
+    model: str | Path | None,
+    start: Any,
+) -> PlanResult:
+    """One best-first search of :func:`plan` (its arguments of the same names), unvalidated."""
     started = time.monotonic()
     limit = (
         max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)

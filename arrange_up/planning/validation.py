@@ -1,0 +1,168 @@
+"""Checking a particle plan on fresh rollouts, and planning again from the starts it failed on.
+
+A plan the particle search finds is conformant for its particles only: every particle, with
+the noise drawn for it, reaches the goal. How far that carries to the problem's whole
+uncertainty depends on how well ``P`` particles show it. :func:`validate_plan` measures it the
+way evaluation does, on rollouts the search never saw: each draws a fresh initial state from the
+problem's initial intervals and fresh noise for every action, and is judged by the evaluation's
+rules (:mod:`arrange_up.evaluation.rollouts`). The initial states of the rollouts that failed
+are *counterexamples*: :func:`arrange_up.planning.planner.plan` adds them to the search's
+initial belief as further particles and searches again, a few rounds at most, so the next plan
+must also bring those starts (with noise drawn anew for them) to the goal.
+
+The validation rollouts are an evaluation with a seed of their own, derived from the planning
+seed and the round (:func:`validation_seed`), never a small integer: an evaluation a user runs
+(seed 0 by default) does not meet the starts the planner was shown, so its figure stays a
+fresh test set.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.rollouts import rollout_start
+from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.world import Action, WorldState
+
+__all__ = [
+    "MIN_VALIDATION_ROLLOUTS",
+    "VALIDATION_REPLANS",
+    "Validation",
+    "ValidationRound",
+    "default_validation_rollouts",
+    "validate_plan",
+    "validation_seed",
+]
+
+#: Searches after the first that validation may start. Measured on the fresh problems
+#: (docs/design/planning.md, "Validated plans"): the rounds that helped needed one or two.
+VALIDATION_REPLANS = 3
+
+#: ``SeedSequence`` key of the validation stream, apart from the planner's other draws.
+_VALIDATION_KEY = 0x5A11D
+
+
+#: The fewest validation rollouts by default: 40 see a plan failing one rollout in ten with
+#: probability 0.985, one in twenty with 0.87.
+MIN_VALIDATION_ROLLOUTS = 40
+
+
+def default_validation_rollouts(particles: int) -> int:
+    """The validation rollouts for a search of ``particles`` particles when none are asked for:
+    twice the particles, so that a user who buys a larger belief also buys a sharper check, and
+    at least :data:`MIN_VALIDATION_ROLLOUTS`."""
+    return max(2 * particles, MIN_VALIDATION_ROLLOUTS)
+
+
+def validation_seed(seed: int, round_: int) -> int:
+    """The evaluation seed of validation round ``round_`` of a planning run with ``seed``: a
+    63-bit integer drawn from ``SeedSequence([seed, key, round_])``."""
+    state = np.random.SeedSequence([seed, _VALIDATION_KEY, round_]).generate_state(1, np.uint64)
+    return int(state[0]) >> 1
+
+
+@dataclass(frozen=True)
+class ValidationRound:
+    """One search of a validated planning run: the particles it searched with (the requested
+    ones plus the counterexamples of the earlier rounds), its status and expanded nodes, and,
+    for a found plan, how many of the validation rollouts succeeded (``None``: no plan)."""
+
+    particles: int
+    status: str
+    expanded: int
+    successes: int | None
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "particles": self.particles,
+            "status": str(self.status),
+            "expanded": self.expanded,
+            "successes": self.successes,
+        }
+
+
+@dataclass(frozen=True)
+class Validation:
+    """The validation of a planning run: ``rollouts`` fresh rollouts per found plan, the rounds
+    in order, and ``chosen``, the index of the round whose plan was returned (the one with the
+    most successes, the later on a tie: it was searched with more particles)."""
+
+    rollouts: int
+    rounds: tuple[ValidationRound, ...]
+    chosen: int
+
+    @property
+    def successes(self) -> int:
+        """Validation successes of the returned plan."""
+        successes = self.rounds[self.chosen].successes
+        assert successes is not None  # a chosen round has a plan
+        return successes
+
+    @property
+    def passed(self) -> bool:
+        """True iff the returned plan succeeded in every validation rollout."""
+        return self.successes == self.rollouts
+
+    def line(self) -> str:
+        """One line for the command line: what the returned plan did on fresh rollouts, and
+        what the extra searches were."""
+        chosen = self.rounds[self.chosen]
+        text = (
+            f"validated on {self.rollouts} fresh rollouts: {self.successes} succeeded"
+            f" (plan of search {self.chosen + 1} of {len(self.rounds)}, "
+            f"{chosen.particles} particles)"
+        )
+        if len(self.rounds) > 1:
+            text += "; searches: " + ", ".join(
+                f"{r.particles} particles {r.status}"
+                + (f" {r.successes}/{self.rollouts}" if r.successes is not None else "")
+                for r in self.rounds
+            )
+        return text
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "rollouts": self.rollouts,
+            "successes": self.successes,
+            "chosen": self.chosen,
+            "rounds": [r.to_json() for r in self.rounds],
+        }
+
+
+def validate_plan(
+    problem: ArrangementProblem,
+    actions: tuple[Action, ...],
+    *,
+    rollouts: int,
+    seed: int,
+    round_: int,
+    workers: int = 1,
+    backend: str = "local",
+    scheduler: str | None = None,
+) -> tuple[int, tuple[WorldState, ...]]:
+    """Run ``rollouts`` rollouts of ``actions`` with :func:`validation_seed` ``(seed, round_)``
+    (on the evaluation's runner: ``workers``, ``backend``, ``scheduler`` as for
+    :func:`~arrange_up.evaluation.evaluate.evaluate_plan`); return the successes and the
+    initial states of the failed rollouts, in rollout order."""
+    vseed = validation_seed(seed, round_)
+    reliability = evaluate_plan(
+        problem,
+        actions,
+        rollouts=rollouts,
+        seed=vseed,
+        workers=workers,
+        backend=backend,
+        scheduler=scheduler,
+        keep_records=True,
+    )
+    assert reliability.records is not None  # asked for with keep_records
+    failed = tuple(
+        rollout_start(problem, vseed, record.index)
+        for record in reliability.records
+        if not record.success
+    )
+    return reliability.successes, failed

@@ -1,0 +1,121 @@
+"""Validated particle plans: a found plan is checked on fresh rollouts, and the starts it failed
+from join the particles of the next search (``arrange_up.planning.validation``)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from arrange_up.cli import main
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.rollouts import rollout_start, trace_rollout
+from arrange_up.io.yaml_problem import load_problem
+from arrange_up.planning.planner import plan
+from arrange_up.planning.validation import VALIDATION_REPLANS, validation_seed
+
+# One block centred on its goal x but spread too wide: two particles do not show the spread,
+# and their plan fails about half of the fresh rollouts.
+NARROW = Path(__file__).resolve().parents[1] / "problems" / "fresh" / "narrow-squeeze.yaml"
+
+
+@pytest.fixture(scope="module")
+def narrow():
+    return load_problem(NARROW)
+
+
+def test_the_starts_of_failed_validation_rollouts_join_the_next_search(narrow) -> None:
+    unvalidated = plan(narrow, particles=2, seed=0, workers=1, validate=0)
+    result = plan(narrow, particles=2, seed=0, workers=1, validate=10)
+    assert unvalidated.validation is None and unvalidated.solved and result.solved
+    validation = result.validation
+    assert validation is not None and validation.rollouts == 10
+    first, second = validation.rounds[:2]
+    # the first search is the unvalidated one, checked on the round-0 validation rollouts
+    assert (first.particles, first.expanded) == (2, unvalidated.stats["expanded"])
+    seed = validation_seed(0, 0)
+    check = evaluate_plan(
+        narrow, unvalidated.actions, rollouts=10, seed=seed, workers=1, keep_records=True
+    )
+    assert first.successes == check.successes < 10
+    failed = [rollout_start(narrow, seed, r.index) for r in check.records if not r.success]
+    # at most ``particles`` counterexamples per round, in rollout order
+    assert second.particles == 2 + min(2, len(failed))
+    # the second search's plan passed: it is returned, planned from the particles plus the
+    # first failed starts, and the result still says the 2 particles asked for
+    assert second.successes == 10 and validation.passed and validation.chosen == 1
+    assert len(validation.rounds) == 2
+    assert result.particles == 2
+    assert result.beliefs[0].particles == unvalidated.beliefs[0].particles + tuple(failed[:2])
+    assert result.actions != unvalidated.actions
+
+
+def test_a_rollout_start_is_the_first_state_of_its_rollout(narrow) -> None:
+    result = plan(narrow, particles=2, seed=0, workers=1, validate=0)
+    for index in (0, 3):
+        assert rollout_start(narrow, 7, index) == trace_rollout(narrow, result.actions, 7, index)[0]
+
+
+def test_validation_is_reproducible_and_stops_at_the_first_plan_that_passes(narrow) -> None:
+    runs = [plan(narrow, particles=4, seed=1, workers=1, validate=12) for _ in range(2)]
+    assert runs[0].actions == runs[1].actions
+    assert runs[0].validation == runs[1].validation
+    rounds = runs[0].validation.rounds
+    assert 1 <= len(rounds) <= VALIDATION_REPLANS + 1
+    assert all(r.successes is not None and r.successes < 12 for r in rounds[:-1])
+    best = max(r.successes for r in rounds if r.successes is not None)
+    assert runs[0].validation.successes == best
+
+
+def test_validation_seeds_are_apart_from_evaluation_seeds_and_from_each_other() -> None:
+    seeds = {validation_seed(seed, round_) for seed in range(3) for round_ in range(4)}
+    assert len(seeds) == 12
+    assert min(seeds) > 1_000_000  # not a seed a user evaluates with
+    assert validation_seed(2, 1) == validation_seed(2, 1)
+
+
+def test_validation_is_on_by_default_for_particles_only(narrow) -> None:
+    particles = plan(narrow, particles=3, seed=0, workers=1)
+    assert particles.validation is not None and particles.validation.rollouts == 40
+    assert plan(narrow, semantics="deterministic").validation is None
+    # a start belief is a posterior, not the initial uncertainty the rollouts draw from
+    start = particles.beliefs[0]
+    assert plan(narrow, particles=3, seed=0, workers=1, start=start).validation is None
+
+
+@pytest.mark.parametrize(
+    "arguments",
+    [
+        {"validate": -1},
+        {"validate": 5, "semantics": "deterministic"},
+        {"validate": 5, "semantics": "cbst"},
+    ],
+)
+def test_bad_validation_arguments_raise(narrow, arguments) -> None:
+    with pytest.raises(ValueError, match="validate"):
+        plan(narrow, particles=2, **arguments)
+
+
+def test_the_command_line_reports_and_records_the_validation(tmp_path: Path) -> None:
+    output = tmp_path / "narrow.plan.json"
+    args = ["plan", str(NARROW), "--particles", "2", "--validate", "10", "--workers", "1"]
+    result = CliRunner().invoke(main, [*args, "--json", "-o", str(output)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    written = json.loads(output.read_text())
+    assert summary["validation"] == written["validation"]
+    assert written["validation"]["rollouts"] == 10
+    assert [r["particles"] for r in written["validation"]["rounds"]][0] == 2
+    assert written["particles"] == 2
+    table = CliRunner().invoke(main, args)
+    assert "validated on 10 fresh rollouts: 10 succeeded (plan of search 2 of 2" in table.output
+
+
+def test_validate_with_another_semantics_exits_2() -> None:
+    result = CliRunner().invoke(
+        main, ["plan", str(NARROW), "--semantics", "deterministic", "--validate", "4"]
+    )
+    assert result.exit_code == 2
+    assert "--validate checks particle plans" in result.output
