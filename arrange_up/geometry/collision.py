@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from functools import lru_cache
 
 import numpy as np
+import shapely
 from shapely.geometry import box as shapely_box
 
 from arrange_up.geometry import shapes as geometry
@@ -46,8 +47,19 @@ class CollisionChecker:
         self.obstacle_boxes = {name: geom.bounds for name, geom in self.obstacles.items()}
         self._fixed = list(self.obstacles.values()) + [_box_geom(b) for b in self.walls.values()]
         self._wall_geoms = {edge: _box_geom(box) for edge, box in self.walls.items()}
+        # Objects whose convex parts leave part of their hull empty: their shadows are the
+        # union of the parts' (shadow_hull).
+        self._concave = {
+            name
+            for name, shape in self.shapes.items()
+            if shape is not None
+            and len(shape.parts) > 1
+            and geometry.footprint(shape.parts, (0.0, 0.0, 0.0)).convex_hull.area
+            > shape.area * (1.0 + 1e-6)
+        }
         self._shadow_box = lru_cache(maxsize=200_000)(self._shadow_box_uncached)
         self._shadow_hull = lru_cache(maxsize=20_000)(self._shadow_hull_uncached)
+        self._piece_boxes = lru_cache(maxsize=20_000)(self._piece_boxes_uncached)
         # a search tests the same shadows (and pairs of them) again and again, since the same
         # objects' beliefs recur in many beliefs; the hulls' distances are the costly part
         self._hulls_meet = lru_cache(maxsize=200_000)(self._hulls_meet_uncached)
@@ -70,13 +82,30 @@ class CollisionChecker:
         return geometry.shadow_box(self.shapes[name].parts, pose, half)
 
     def _shadow_hull_uncached(self, name: str, pose: Pose, half: HalfWidths):
-        return geometry.shadow_hull(self.shapes[name].parts, pose, half)
+        parts = self.shapes[name].parts
+        if name not in self._concave:
+            return geometry.shadow_hull(parts, pose, half)
+        return shapely.union_all([geometry.shadow_hull([part], pose, half) for part in parts])
+
+    def _piece_boxes_uncached(self, name: str, pose: Pose, half: HalfWidths) -> tuple[Box, ...]:
+        if name not in self._concave:
+            return (self.shadow_box(name, pose, half),)
+        return tuple(geometry.shadow_box([part], pose, half) for part in self.shapes[name].parts)
 
     def shadow_box(self, name: str, pose: Pose, half: HalfWidths):
         return self._shadow_box(name, tuple(pose), tuple(half))
 
     def shadow_hull(self, name: str, pose: Pose, half: HalfWidths):
+        """The object's shadow: a convex polygon containing it at every pose of the interval
+        (:func:`~arrange_up.geometry.shadows.shadow_hull`), or for a concave object (one whose
+        convex parts do not fill their hull: an L, a T, a U) the union of its parts' shadows,
+        so that its notches stay open to what fits in them."""
         return self._shadow_hull(name, tuple(pose), tuple(half))
+
+    def piece_boxes(self, name: str, pose: Pose, half: HalfWidths) -> tuple[Box, ...]:
+        """The shadow boxes of the object's convex parts if it is concave (their union holds
+        its shadow, notches left open), else its one shadow box."""
+        return self._piece_boxes(name, tuple(pose), tuple(half))
 
     def shadows_overlap(
         self, a: tuple[str, Pose, HalfWidths], b: tuple[str, Pose, HalfWidths]

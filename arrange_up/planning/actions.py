@@ -396,6 +396,11 @@ class ActionGenerator:
             if spec.name in self.problem.goal.parts
         )
         boxes = [(name, self.checker.shadow_box(name, c, h)) for name, c, h in on_table]
+        # The approach's clearance across is sought against each convex part of a concave
+        # shadow: its whole box would close the notch a part is pushed into.
+        pieces = [
+            (name, box) for name, c, h in on_table for box in self.checker.piece_boxes(name, c, h)
+        ]
         actions: list[Push] = []
         for manip in self.manipulators:
             if manip.spec.name in belief:
@@ -420,6 +425,7 @@ class ActionGenerator:
                         belief,
                         on_table,
                         boxes,
+                        pieces,
                         ladder,
                         routes,
                         detours.get(direction),
@@ -487,6 +493,7 @@ class ActionGenerator:
         belief,
         on_table,
         boxes,
+        pieces,
         ladder=False,
         routes=None,
         detour: float | None = None,
@@ -494,7 +501,8 @@ class ActionGenerator:
         turning: bool = False,
     ) -> list[Push]:
         """The pushes of part ``name`` along ``direction``; ``on_table`` are the belief's
-        shadows ``(name, centre, half)`` and ``boxes`` their ``(name, shadow box)``. Those that
+        shadows ``(name, centre, half)``, ``boxes`` their ``(name, shadow box)`` and ``pieces``
+        the same with a concave shadow's box split into its parts'. Those that
         would drive a state of the part into an obstacle (:meth:`_cut_short`) are also appended
         to ``jams``. ``turning``: the part is also offered turning pushes (the module
         docstring; decided once per part by :meth:`pushes`)."""
@@ -534,18 +542,18 @@ class ActionGenerator:
             # the shadow and APPROACH_GAP add across: only a noisy approach grazes them); else
             # where it was (it stops on one as the part reaches its end).
             centres = self._across(
-                manip, name, interval, axis, sign, along, m_box, boxes, sweep, passing
+                manip, name, interval, axis, sign, along, m_box, pieces, sweep, passing
             )
             if sweep and not centres:
                 other = 1 - axis
                 margin = 0.5 * (m_box[other + 2] - m_box[other] - manip.length) + APPROACH_GAP
                 shrunk = tuple(_shrink(box, other, margin) for box in sweep)
                 centres = self._across(
-                    manip, name, interval, axis, sign, along, m_box, boxes, shrunk, passing
+                    manip, name, interval, axis, sign, along, m_box, pieces, shrunk, passing
                 )
             if sweep and not centres:
                 centres = self._across(
-                    manip, name, interval, axis, sign, along, m_box, boxes, (), passing
+                    manip, name, interval, axis, sign, along, m_box, pieces, (), passing
                 )
             if self.fences.needs and group:
                 centres = self._clear_of_fences(

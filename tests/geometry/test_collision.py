@@ -136,14 +136,29 @@ def test_touching_shadows_overlap_and_a_hair_apart_they_do_not():
     assert checker.shadows_overlap(far, ("A", (5.0, 2.5, 0.0), (0.2, 0.0, 0.0)))
 
 
-def test_shadow_hulls_are_convex_so_the_notch_is_conservatively_blocked(l_and_square):
-    # The exact footprints leave room in the notch (see above); the shadow test, which must
-    # be conservative, fills the notch with the L's convex hull.
+def test_a_concave_shadow_leaves_its_notch_open_to_what_fits_in_it(l_and_square):
+    # The L's shadow is the union of its convex parts' shadows, not one hull that would fill
+    # its notch (the unit square missing from it): a half-inch square fits there while the
+    # L's pose is known, and its uncertainty closes the notch again.
     checker = CollisionChecker(l_and_square)
     L = l_and_square.initial_of("L").pose
     cx, cy = notch_centre(l_and_square)
-    assert checker.shadows_overlap(("L", L, NONE), ("s", (cx, cy, 0.0), NONE))
-    assert not checker.shadows_overlap(("L", L, NONE), ("s", (cx + 1.0, cy + 1.0, 0.0), NONE))
+    square = ("s", (cx, cy, 0.0), NONE)
+    assert not checker.shadows_overlap(("L", L, NONE), square)
+    assert not checker.shadows_overlap(square, ("L", L, NONE))
+    assert checker.shadows_overlap(("L", L, (0.3, 0.0, 0.0)), square)
+    assert checker.shadows_overlap(("L", L, (0.0, 0.0, math.radians(30))), square)
+    assert checker.shadows_overlap(("L", L, NONE), ("s", (cx - 0.5, cy, 0.0), NONE))
+    # its pieces' boxes split its box; a convex object keeps its one hull and box
+    pieces = checker.piece_boxes("L", L, NONE)
+    box = checker.shadow_box("L", L, NONE)
+    assert len(pieces) == 2
+    assert min(b[0] for b in pieces) == pytest.approx(box[0])
+    assert max(b[3] for b in pieces) == pytest.approx(box[3])
+    assert checker.piece_boxes("s", (cx, cy, 0.0), NONE) == (
+        checker.shadow_box("s", (cx, cy, 0.0), NONE),
+    )
+    assert checker.shadow_hull("s", (cx, cy, 0.0), NONE).geom_type == "Polygon"
 
 
 def test_shadow_hits_walls_and_obstacles_only_where_they_are():

@@ -69,3 +69,17 @@ def test_a_block_whose_shadow_would_catch_a_posts_corner_goes_up_first():
     after = result.beliefs[1].intervals.get("A")
     shadow = CollisionChecker(problem).shadow_box("A", after.center, after.half)
     assert shadow[1] > 0.6
+
+
+def test_a_cube_is_pushed_into_the_nook_of_an_ell_squared_in_its_corner():
+    # mm-ell-nook: the L starts turned 0.6 rad; squared and pressed into the corner, its nook
+    # (2.5 mm to spare round the cube) is open to the cube's place beside it and to the pushes
+    # that drive the cube in, the paddle clear of the L's arms.
+    problem = load_problem(FRESH / "mm-ell-nook.yaml")
+    result = arrange_up.plan(problem, semantics="deterministic")
+    assert result.solved, result.reason
+    place = next(a for a in result.actions if not isinstance(a, Push))
+    goal = problem.goal.target("B")
+    assert place.pose[0] > goal[0] and place.pose[1] > goal[1]  # beside the nook, not in it
+    final = result.beliefs[-1]
+    assert GoalTest(problem).satisfied_array(final.poses, final.names())
