@@ -3,24 +3,24 @@
 Usage::
 
     python benchmarks/fresh_problems.py [--particles 20] [--semantics particles] [--validate V]
-        [--timeout 300] [--rollouts 200] [--problems tests/problems/fresh/*.yaml]
+        [--seed 0] [--timeout 300] [--rollouts 200] [--problems tests/problems/fresh/*.yaml]
         [--output fresh.csv]
 
 For each problem file (default: every file of ``tests/problems/fresh/``, written for issue 13's
-kinds: a narrowing squeeze, a detour round a post, a relative pair whose reference must move,
-an open-table goal that needs a fixture, an L part into a corner, a 5-block T, a column of four,
-a tight row; four that need the planner's own fence (fence-corner; a corner of two fences on
-a wall-less table twice, fence-open-corner and fence-middle-corner; and fence-row, a row pressed
-against one); four with a fixed post: on the straight line to the goal in the open, on the
-wall between a block lying on that wall and its goal, just beyond the goal, and flush with the
-goal; and eight written blind by an outsider to the planner, in other units, shapes, walls and
-paddles, four with relative goals), plans as ``arrange-up plan FILE --particles N --semantics
-S [--validate V]`` does (seed 0, one worker), then evaluates a found plan with ``--rollouts``
-noisy rollouts (seed 0) and prints a row: status, nodes expanded (of the search whose plan was
-returned), planning seconds (validation and every search included), plan length, the planner's
-validation rollouts, searches and validation successes, successes of the evaluation, and the
-planner's reason when no plan was found. Each row is appended to the CSV (if given) as
-soon as it is measured.
+kinds: a narrowing squeeze, a detour round a post, a relative pair whose reference must move, an
+open-table goal that needs a fixture, an L part into a corner, a 5-block T, a column of four, a
+tight row; four that need the planner's own fence (fence-corner; a corner of two fences on a
+wall-less table twice, fence-open-corner and fence-middle-corner; and fence-row, a row pressed
+against one); four with a fixed post: on the straight line to the goal in the open, on the wall
+between a block lying on that wall and its goal, just beyond the goal, and flush with the goal;
+and eight written blind by an outsider to the planner, in other units, shapes, walls and
+paddles, four with relative goals), plans as ``arrange-up plan FILE --particles N --semantics S
+[--validate V] --seed K`` does (``--seed``, default 0; one worker), then evaluates a found plan
+with ``--rollouts`` noisy rollouts (seed 0) and prints a row: status, nodes expanded (of the
+search whose plan was returned), planning seconds (validation and every search included), plan
+length, the planner's validation rollouts, searches and validation successes, successes of the
+evaluation, and the planner's reason when no plan was found. Each row is appended to the CSV (if
+given) as soon as it is measured.
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from arrange_up.planning.planner import plan
 FRESH = Path(__file__).resolve().parents[1] / "tests" / "problems" / "fresh"
 FIELDS = [
     "problem",
+    "seed",
     "controller",
     "semantics",
     "particles",
@@ -60,6 +61,7 @@ def measure(
     rollouts: int,
     semantics: str = "particles",
     validate: int | None = None,
+    seed: int = 0,
 ) -> dict[str, object]:
     problem = load_problem(path)
     started = time.perf_counter()
@@ -67,7 +69,7 @@ def measure(
         problem,
         semantics=semantics,
         particles=particles,
-        seed=0,
+        seed=seed,
         workers=1,
         timeout=timeout,
         validate=validate,
@@ -76,6 +78,7 @@ def measure(
     seconds = time.perf_counter() - started
     row: dict[str, object] = {
         "problem": problem.name,
+        "seed": seed,
         "controller": problem.controller.kind.value,
         "semantics": result.semantics,
         "particles": result.particles,
@@ -103,6 +106,7 @@ def main() -> None:
     parser.add_argument("--semantics", default="particles", help="deterministic, particles, ...")
     parser.add_argument("--timeout", type=float, default=300.0, help="planning seconds")
     parser.add_argument("--rollouts", type=int, default=200)
+    parser.add_argument("--seed", type=int, default=0, help="the planner's seed")
     parser.add_argument(
         "--validate",
         type=int,
@@ -123,7 +127,13 @@ def main() -> None:
     try:
         for path in paths:
             row = measure(
-                path, args.particles, args.timeout, args.rollouts, args.semantics, args.validate
+                path,
+                args.particles,
+                args.timeout,
+                args.rollouts,
+                args.semantics,
+                args.validate,
+                args.seed,
             )
             print(" ".join(f"{k}={row[k]}" for k in FIELDS if row[k] != ""), flush=True)
             if writer is not None and handle is not None:

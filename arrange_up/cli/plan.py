@@ -109,7 +109,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     help="Particle semantics: check a found plan on this many fresh rollouts (new initial "
     "states and noise, judged as evaluate judges them); when some fail, search again with "
     "their initial states added to the particles, up to 3 more times, and return the plan "
-    "that did best. 0 turns it off. [default: twice --particles, at least 40; off for other "
+    "that did best. 0 turns it off. [default: twice --particles, at least 60; off for other "
     "semantics]",
 )
 @parallel_options("simulations of the successors the search will evaluate next")
@@ -161,7 +161,7 @@ def plan(
     semantics predicts in this process: it starts no workers or cluster.
 
     A particle plan is conformant for its particles only, so it is checked on twice --particles
-    fresh rollouts, at least 40 (--validate); their failed starts become further particles of up
+    fresh rollouts, at least 60 (--validate); their failed starts become further particles of up
     to three more searches, and the line after the statistics says how the returned plan did.
     The rollouts are seeded apart from evaluate's, which stays a fresh test.
 

@@ -313,7 +313,7 @@ def plan(
         at most :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while
         ``timeout`` leaves time. The plan returned is the one that succeeded in most validation
         rollouts, and :attr:`PlanResult.validation` says how each search did. ``None`` (default):
-        twice ``particles``, at least 40, for the ``particles`` semantics planning from the
+        twice ``particles``, at least 60, for the ``particles`` semantics planning from the
         problem's initial belief, else 0 (off); 0 turns it off. Other semantics, and a ``start``
         belief (a posterior, not the problem's initial uncertainty), take no validation: a positive
         value for them raises ``ValueError``.

@@ -112,6 +112,22 @@ def test_parameters_are_checked():
         OneshotPlanner(name="arrange-up", params={"semantics": "nope"})
     with pytest.raises(ValueError, match="particles must be a positive integer"):
         OneshotPlanner(name="arrange-up", params={"particles": 0})
+    with pytest.raises(ValueError, match="validate must be a non-negative integer"):
+        OneshotPlanner(name="arrange-up", params={"validate": -1})
+    with pytest.raises(ValueError, match="validate checks particle plans"):
+        OneshotPlanner(name="arrange-up", params={"semantics": "cbst", "validate": 4})
+
+
+def test_a_particle_plan_reports_its_validation():
+    params = {"particles": 2, "seed": 0, "validate": 6}
+    result = _solve(to_up(load("blocks-1")), params=params, timeout=60)
+    assert result.status is Status.SOLVED_SATISFICING
+    assert result.metrics["validation_rollouts"] == "6"
+    assert 0 <= int(result.metrics["validation_successes"]) <= 6
+    assert int(result.metrics["validation_searches"]) >= 1
+    assert any("validated on 6 fresh rollouts" in log.message for log in result.log_messages)
+    unchecked = _solve(to_up(load("blocks-1")), params={**params, "validate": 0}, timeout=60)
+    assert "validation_rollouts" not in unchecked.metrics
 
 
 def test_registration_is_idempotent():

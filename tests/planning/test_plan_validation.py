@@ -78,7 +78,7 @@ def test_validation_seeds_are_apart_from_evaluation_seeds_and_from_each_other() 
 
 def test_validation_is_on_by_default_for_particles_only(narrow) -> None:
     particles = plan(narrow, particles=3, seed=0, workers=1)
-    assert particles.validation is not None and particles.validation.rollouts == 40
+    assert particles.validation is not None and particles.validation.rollouts == 60
     assert plan(narrow, semantics="deterministic").validation is None
     # a start belief is a posterior, not the initial uncertainty the rollouts draw from
     start = particles.beliefs[0]
