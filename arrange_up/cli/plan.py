@@ -38,7 +38,8 @@ from arrange_up.planning.planner import plan as run_plan
 def _status_line(stats: dict[str, Any]) -> str:
     """The live search status shown on a terminal."""
     best = stats.get("best_h")
-    return (
+    again = f"search {stats['search']} (validation failed): " if "search" in stats else ""
+    return again + (
         f"expanded {stats['expanded']:>6}  generated {stats['generated']:>7}  "
         f"simulated {stats['transitions_simulated']:>8}  best h "
         f"{'-' if best is None else f'{best:g}'}  {stats['elapsed']:6.1f} s"

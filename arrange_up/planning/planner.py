@@ -9,6 +9,7 @@ status.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from collections import Counter
@@ -293,7 +294,9 @@ def plan(
         valid plans of the unchanged problem.
     progress
         Receives the search statistics so far (``SearchSnapshot.to_json()``) every
-        :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end.
+        :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end of each search;
+        the searches a failed validation starts (``validate``) begin again from zero, and
+        their dicts also hold ``search``, the search's number (2, 3, ...).
     should_stop
         Polled during the search; returning True cancels it (status ``cancelled``).
     model
@@ -330,8 +333,11 @@ def plan(
         )
     started = time.monotonic()
 
-    def search(start: Any, particles: int) -> PlanResult:
+    def search(start: Any, particles: int, number: int = 1) -> PlanResult:
         left = None if timeout is None else max(0.0, timeout - (time.monotonic() - started))
+        report = progress
+        if progress is not None and number > 1:
+            report = functools.partial(_numbered, progress, number)
         return _search(
             problem,
             semantics=semantics,
@@ -348,7 +354,7 @@ def plan(
             scheduler=scheduler,
             tie_break=tie_break,
             variety=variety,
-            progress=progress,
+            progress=report,
             should_stop=should_stop,
             model=model,
             start=start,
@@ -364,7 +370,7 @@ def plan(
         if round_:
             belief = found[-1].beliefs[0]  # type: ignore[index]  # a solved search's start
             belief = ParticleBelief(belief.particles + failed[:particles])
-            result = search(belief, len(belief.poses))
+            result = search(belief, len(belief.poses), round_ + 1)
         size = len(result.beliefs[0].poses) if result.beliefs else particles
         if not result.solved:
             rounds.append(ValidationRound(size, result.status, result.stats["expanded"], None))
@@ -394,6 +400,11 @@ def plan(
         statistics=statistics,
         validation=Validation(validate, tuple(rounds), chosen),
     )
+
+
+def _numbered(progress: ProgressCallback, number: int, stats: dict[str, Any]) -> None:
+    """``progress`` of search ``number`` of a validated run: its statistics and its number."""
+    progress({**stats, "search": number})
 
 
 def _search(

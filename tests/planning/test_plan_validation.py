@@ -10,6 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from arrange_up.cli import main
+from arrange_up.cli.plan import _status_line
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.rollouts import rollout_start, trace_rollout
 from arrange_up.io.yaml_problem import load_problem
@@ -50,6 +51,17 @@ def test_the_starts_of_failed_validation_rollouts_join_the_next_search(narrow) -
     assert result.particles == 2
     assert result.beliefs[0].particles == unvalidated.beliefs[0].particles + tuple(failed[:2])
     assert result.actions != unvalidated.actions
+
+
+def test_progress_numbers_the_searches_a_failed_validation_starts(narrow) -> None:
+    snapshots: list[dict] = []
+    result = plan(narrow, particles=2, seed=0, workers=1, validate=10, progress=snapshots.append)
+    assert len(result.validation.rounds) == 2
+    numbers = [s.get("search") for s in snapshots]
+    assert numbers[0] is None and numbers[-1] == 2  # the first search unnumbered, then the second
+    assert numbers == sorted(numbers, key=lambda n: n or 1)
+    assert "search 2 (validation failed): expanded" in _status_line(snapshots[-1])
+    assert _status_line(snapshots[0]).startswith("expanded")
 
 
 def test_a_rollout_start_is_the_first_state_of_its_rollout(narrow) -> None:
