@@ -366,12 +366,13 @@ def plan(
     found: list[PlanResult] = []
     rounds: list[ValidationRound] = []
     failed: tuple[WorldState, ...] = ()
+    size = particles
     for round_ in range(VALIDATION_REPLANS + 1):
         if round_:
             belief = found[-1].beliefs[0]  # type: ignore[index]  # a solved search's start
             belief = ParticleBelief(belief.particles + failed[:particles])
-            result = search(belief, len(belief.poses), round_ + 1)
-        size = len(result.beliefs[0].poses) if result.beliefs else particles
+            size = len(belief.poses)
+            result = search(belief, size, round_ + 1)
         if not result.solved:
             rounds.append(ValidationRound(size, result.status, result.stats["expanded"], None))
             break

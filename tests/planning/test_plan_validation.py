@@ -64,6 +64,16 @@ def test_progress_numbers_the_searches_a_failed_validation_starts(narrow) -> Non
     assert _status_line(snapshots[0]).startswith("expanded")
 
 
+def test_a_replan_without_a_plan_is_recorded_and_the_last_plan_found_returned(narrow) -> None:
+    # Two nodes solve the two-particle search but not the four-particle one that follows it.
+    first = plan(narrow, particles=2, seed=0, workers=1, validate=0, max_nodes=2)
+    result = plan(narrow, particles=2, seed=0, workers=1, validate=10, max_nodes=2)
+    found, replan = result.validation.rounds
+    assert found.successes < 10 and result.validation.chosen == 0
+    assert (replan.particles, replan.status, replan.successes) == (4, "node-limit", None)
+    assert result.actions == first.actions
+
+
 def test_a_rollout_start_is_the_first_state_of_its_rollout(narrow) -> None:
     result = plan(narrow, particles=2, seed=0, workers=1, validate=0)
     for index in (0, 3):
