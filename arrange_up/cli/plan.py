@@ -33,6 +33,7 @@ from arrange_up.parallel import BackendUnavailableError, available_cores
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import DEFAULT_MAX_NODES, DEFAULT_WEIGHT
 from arrange_up.planning.planner import plan as run_plan
+from arrange_up.planning.validation import check_validate
 
 
 def _status_line(stats: dict[str, Any]) -> str:
@@ -171,8 +172,10 @@ def plan(
     input. An unsolved run prints one line of why.
     """
     check_semantics(semantics)
-    if validate and semantics != "particles":
-        fail(f"--validate checks particle plans; --semantics {semantics} takes none")
+    try:
+        check_validate(validate, semantics)
+    except ValueError as error:  # the message starts with the option's name
+        fail(f"--{error}")
     backend = backend_choice(backend, scheduler)
     loaded = load_problem(problem)
     if semantics == "cbst":

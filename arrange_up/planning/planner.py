@@ -32,6 +32,7 @@ from arrange_up.planning.validation import (
     VALIDATION_REPLANS,
     Validation,
     ValidationRound,
+    check_validate,
     default_validation_rollouts,
     validate_plan,
 )
@@ -321,15 +322,12 @@ def plan(
         belief (a posterior, not the problem's initial uncertainty), take no validation: a positive
         value for them raises ``ValueError``.
     """
+    check_validate(validate, semantics, start)
     if validate is None:
-        validate = default_validation_rollouts(particles) if semantics == "particles" else 0
-        validate = validate if start is None else 0
-    if validate < 0:
-        raise ValueError(f"validate must be a non-negative integer, got {validate!r}")
-    if validate and (semantics != "particles" or start is not None):
-        raise ValueError(
-            "validate applies to the particles semantics planning from the problem's initial "
-            f"belief, not to {semantics!r}" + (" with a start belief" if start is not None else "")
+        validate = (
+            default_validation_rollouts(particles)
+            if semantics == "particles" and start is None
+            else 0
         )
     started = time.monotonic()
 

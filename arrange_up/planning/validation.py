@@ -33,6 +33,7 @@ __all__ = [
     "VALIDATION_REPLANS",
     "Validation",
     "ValidationRound",
+    "check_validate",
     "default_validation_rollouts",
     "validate_plan",
     "validation_seed",
@@ -57,6 +58,23 @@ def default_validation_rollouts(particles: int) -> int:
     twice the particles, so that a user who buys a larger belief also buys a sharper check, and
     at least :data:`MIN_VALIDATION_ROLLOUTS`."""
     return max(2 * particles, MIN_VALIDATION_ROLLOUTS)
+
+
+def check_validate(validate: Any, semantics: str, start: Any = None) -> None:
+    """``ValueError`` unless ``validate`` suits a planning run of ``semantics`` (from a
+    ``start`` belief when one is given): None (the default), or a non-negative integer that is
+    positive only for the ``particles`` semantics planning from the problem's initial belief
+    (the validation rollouts start from that belief, not from a posterior)."""
+    if validate is None:
+        return
+    if not isinstance(validate, int) or isinstance(validate, bool) or validate < 0:
+        raise ValueError(f"validate must be a non-negative integer, got {validate!r}")
+    if validate and semantics != "particles":
+        raise ValueError(f"validate checks particle plans; the {semantics} semantics takes none")
+    if validate and start is not None:
+        raise ValueError(
+            "validate checks plans from the problem's initial belief; a start belief takes none"
+        )
 
 
 def validation_seed(seed: int, round_: int) -> int:

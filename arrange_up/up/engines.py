@@ -140,6 +140,7 @@ from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Place, Push
 from arrange_up.parallel import BACKENDS
 from arrange_up.planning import planner
+from arrange_up.planning.validation import check_validate
 from arrange_up.repair import METHODS, TIMEOUT, repair_plan
 from arrange_up.transitions import available
 from arrange_up.transitions.particles import DeterministicSemantics
@@ -563,15 +564,10 @@ def _check_params(
         raise ValueError(f"arrange-up: seed must be an integer, got {seed!r}")
     if max_nodes is not None and not _positive(max_nodes):
         raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
-    if validate is not None:
-        if not isinstance(validate, int) or isinstance(validate, bool) or validate < 0:
-            raise ValueError(
-                f"arrange-up: validate must be a non-negative integer, got {validate!r}"
-            )
-        if validate and semantics != "particles":
-            raise ValueError(
-                f"arrange-up: validate checks particle plans; the {semantics} semantics takes none"
-            )
+    try:
+        check_validate(validate, semantics)
+    except ValueError as error:
+        raise ValueError(f"arrange-up: {error}") from None
     if model is not None:
         if semantics != "cbst":
             raise ValueError(
