@@ -47,16 +47,16 @@ class CollisionChecker:
         self.obstacle_boxes = {name: geom.bounds for name, geom in self.obstacles.items()}
         self._fixed = list(self.obstacles.values()) + [_box_geom(b) for b in self.walls.values()]
         self._wall_geoms = {edge: _box_geom(box) for edge, box in self.walls.items()}
-        # Objects whose convex parts leave part of their hull empty: their shadows are the
-        # union of the parts' (shadow_hull).
-        self._concave = {
+        #: Objects whose convex parts leave part of their hull empty: their shadows are the
+        #: union of the parts' (:meth:`shadow_hull`, :meth:`piece_boxes`).
+        self.concave = frozenset(
             name
             for name, shape in self.shapes.items()
             if shape is not None
             and len(shape.parts) > 1
             and geometry.footprint(shape.parts, (0.0, 0.0, 0.0)).convex_hull.area
             > shape.area * (1.0 + 1e-6)
-        }
+        )
         self._shadow_box = lru_cache(maxsize=200_000)(self._shadow_box_uncached)
         self._shadow_hull = lru_cache(maxsize=20_000)(self._shadow_hull_uncached)
         self._piece_boxes = lru_cache(maxsize=20_000)(self._piece_boxes_uncached)
@@ -83,12 +83,12 @@ class CollisionChecker:
 
     def _shadow_hull_uncached(self, name: str, pose: Pose, half: HalfWidths):
         parts = self.shapes[name].parts
-        if name not in self._concave:
+        if name not in self.concave:
             return geometry.shadow_hull(parts, pose, half)
         return shapely.union_all([geometry.shadow_hull([part], pose, half) for part in parts])
 
     def _piece_boxes_uncached(self, name: str, pose: Pose, half: HalfWidths) -> tuple[Box, ...]:
-        if name not in self._concave:
+        if name not in self.concave:
             return (self.shadow_box(name, pose, half),)
         return tuple(geometry.shadow_box([part], pose, half) for part in self.shapes[name].parts)
 

@@ -398,9 +398,13 @@ class ActionGenerator:
         boxes = [(name, self.checker.shadow_box(name, c, h)) for name, c, h in on_table]
         # The approach's clearance across is sought against each convex part of a concave
         # shadow: its whole box would close the notch a part is pushed into.
-        pieces = [
-            (name, box) for name, c, h in on_table for box in self.checker.piece_boxes(name, c, h)
-        ]
+        pieces = boxes
+        if any(name in self.checker.concave for name, _, _ in on_table):
+            pieces = [
+                (name, box)
+                for name, c, h in on_table
+                for box in self.checker.piece_boxes(name, c, h)
+            ]
         actions: list[Push] = []
         for manip in self.manipulators:
             if manip.spec.name in belief:
