@@ -3,6 +3,8 @@
     python benchmarks/closed_loop.py --problems tz-mating --episodes 20
     python benchmarks/closed_loop.py --problems blocks-4 --noise-scale 2 --plan-semantics particles
     python benchmarks/closed_loop.py --problems tz-mating,create-a-t --episodes 200 --output-dir out
+    python benchmarks/closed_loop.py --problems create-a-t --plan-semantics particles \
+        --plan-particles 25 --episodes 200 --distinct
 
 For each problem: a first plan (``--plan-semantics``: ``deterministic`` gives the nominal plan,
 the open-loop comparator of the mating problems; ``particles`` a particle plan), then the same
@@ -24,7 +26,7 @@ import sys
 from pathlib import Path
 
 from arrange_up.evaluation.reliability import wilson_interval
-from arrange_up.execution.episodes import EpisodeRecord, run_episodes
+from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.io.domains import load
 from arrange_up.planning.planner import plan
@@ -56,6 +58,12 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="Print closed_loop.json as a Markdown table, run nothing.",
     )
+    parser.add_argument(
+        "--distinct",
+        action="store_true",
+        help="Print, per episode, the distinct states among the filter's particles after each "
+        "action (the first plan executed with sensing, never replanning), record nothing.",
+    )
     args = parser.parse_args(argv)
     out = args.output_dir
     summary_path = out / "closed_loop.json"
@@ -72,6 +80,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{name}: no first plan ({first.reason})", flush=True)
             continue
         actions = first.actions or ()
+        if args.distinct:
+            distinct(problem, actions, args)
+            continue
         closed = ClosedLoopSettings(
             filter_particles=args.filter_particles,
             semantics=args.semantics,
@@ -82,6 +93,8 @@ def main(argv: list[str] | None = None) -> int:
             adapt=not args.no_adapt,
         )
         tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
+        if args.plan_semantics == "particles":
+            tag += str(args.plan_particles)
         if args.landing != "fail":
             tag += f".{args.landing}"
         row = {}
@@ -123,6 +136,8 @@ def main(argv: list[str] | None = None) -> int:
                 "sense": sense,
             }
         row["plan"] = {"semantics": args.plan_semantics, "actions": len(actions)}
+        if args.plan_semantics == "particles":
+            row["plan"]["particles"] = args.plan_particles
         row["noise_scale"] = args.noise_scale
         row["landing"] = args.landing
         # read again before writing: another run may have added its problems meanwhile
@@ -138,6 +153,32 @@ def main(argv: list[str] | None = None) -> int:
             flush=True,
         )
     return 0
+
+
+def distinct(problem, actions, args) -> None:
+    """``--distinct``: how many distinct states the posterior holds after each action."""
+    settings = ClosedLoopSettings(
+        filter_particles=args.filter_particles, threshold=0.0, landing=args.landing
+    )
+    counts = []
+    for episode in range(args.episodes):
+        _, outcome, _ = run_episode(
+            problem,
+            actions,
+            args.sense,
+            settings,
+            args.seed,
+            episode,
+            scale=args.noise_scale,
+            trace=True,
+        )
+        row = [len({p.poses for p in step.posterior.particles}) for step in outcome.trace]
+        counts.extend(row)
+        print(f"{problem.name} episode {episode}: distinct states after each action {row}")
+    print(
+        f"{problem.name}: {args.filter_particles} particles held {min(counts)} to "
+        f"{max(counts)} distinct states (median {statistics.median(counts):g}) after an action"
+    )
 
 
 def _read(path: Path) -> tuple[dict, dict[int, EpisodeRecord]]:
@@ -204,6 +245,10 @@ def table(out: Path) -> str:
             how = f"{s['semantics']}, {s['particles']} particles"
         how += f", {s['max_nodes']} nodes, {s['budget']:g} s"
         how += "" if s.get("adapt") else ", no adapt"
+        if "significance" in s:  # the rule since replans are confirmed and sign-tested
+            how += f", adopted at p < {s['significance']:g} on {s['score_rollouts']} rollouts"
+        else:
+            how += f", adopted if higher on {s['check_rollouts']} rollouts"
         won = sum(closed[i].success and not opened[i].success for i in common)
         lost = sum(opened[i].success and not closed[i].success for i in common)
         lines.append(
