@@ -45,7 +45,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--particles", type=int, default=10)
     parser.add_argument("--max-nodes", type=int, default=300)
     parser.add_argument("--replan-budget", type=float, default=30.0)
-    parser.add_argument("--filter-particles", type=int, default=64)
+    parser.add_argument(
+        "--filter-particles", type=int, default=ClosedLoopSettings().filter_particles
+    )
     parser.add_argument("--landing", default="fail", choices=("fail", "shove"))
     parser.add_argument(
         "--no-adapt",
@@ -213,7 +215,8 @@ def table(out: Path) -> str:
     hold (paired), as a Markdown table: both rates with their 95% Wilson intervals, the
     closed loop's replans per episode, median seconds per replan, model failures, failures by
     kind, the episodes only the closed (won) or only the open loop (lost) got right with the
-    sign test's p of that split, and the replanning settings its header records."""
+    sign test's p of that split, and the replanning settings and filter size its header
+    records."""
     lines = [
         "| run | open loop | closed loop | replans / episode | median s / replan "
         "| model failures | closed-loop failures (goal / action / rest / off) "
@@ -245,10 +248,7 @@ def table(out: Path) -> str:
             how = f"{s['semantics']}, {s['particles']} particles"
         how += f", {s['max_nodes']} nodes, {s['budget']:g} s"
         how += "" if s.get("adapt") else ", no adapt"
-        if "significance" in s:  # the rule since replans are confirmed and sign-tested
-            how += f", adopted at p < {s['significance']:g} on {s['score_rollouts']} rollouts"
-        else:
-            how += f", adopted if higher on {s['check_rollouts']} rollouts"
+        how += f"; filter {s['filter_particles']} particles"
         won = sum(closed[i].success and not opened[i].success for i in common)
         lost = sum(opened[i].success and not closed[i].success for i in common)
         lines.append(

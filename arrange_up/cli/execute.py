@@ -147,10 +147,9 @@ def execute(
     Each episode draws a world (initial poses, every action's noise, scaled by --noise-scale),
     executes the plan one action at a time in the physics, conditions a particle belief on
     what --sense observes (a belief that cannot explain an observation is reported as a model
-    failure), estimates the rest of the plan's success under the posterior and, when more
-    rollouts confirm it below --threshold, replans from the posterior; a plan found replaces
-    the current one only if it succeeds significantly more often on the same rollouts.
-    Without PLAN.json, the first plan is made with --semantics. Prints the success rate with its 95% Wilson interval, replans per
+    failure), estimates the rest of the plan's success under the posterior and replans from
+    the posterior when it falls below --threshold. Without PLAN.json, the first plan is made
+    with --semantics. Prints the success rate with its 95% Wilson interval, replans per
     episode, planning time per replan and the failures by kind.
 
     \b

@@ -6,18 +6,15 @@ plan one action at a time. After each action it conditions its particle belief o
 observation (:class:`~arrange_up.execution.belief.ParticleFilter`) and estimates the remaining
 plan's success under the posterior with a few rollouts (``check_rollouts`` particles drawn
 from the posterior, each running the rest of the plan under the model's noise, then the goal
-test). When the estimate falls below ``threshold`` it scores the rest of the plan again on
-``score_rollouts`` fresh rollouts; only if that confirms the estimate does it replan from the
-posterior (:func:`arrange_up.planning.planner.plan` with ``start=``) within ``budget``
-seconds. Every plan found is scored on the same rollouts as the rest of the current plan
-(each rollout from the same posterior particle), and the best replaces the current plan only
-when it wins significantly: it succeeds on more of the paired rollouts where the two differ
-than it fails, with a one-sided sign test below ``significance`` (why: docs/execution.md,
-"Replanning"). When the plan has run out it checks the goal under the posterior (the
-fraction of particles that satisfy it) and replans again if that is below the threshold.
-The loop ends when the plan has run out and the posterior satisfies the goal, when no plan
-found beats stopping there, after ``max_replans`` replans, ``max_actions`` actions, or at the
-first action the executor could not carry out.
+test). When the estimate falls below ``threshold`` it replans from the posterior
+(:func:`arrange_up.planning.planner.plan` with ``start=``) within ``budget`` seconds, scores
+every plan found and the rest of the current plan on the same rollouts from the posterior,
+and goes on with the best (a new plan only when it beats the current one). When the plan has
+run out it checks the goal under the posterior (the fraction of particles that satisfy it)
+and replans again if that is below the threshold. The loop ends when the plan has run out
+and the posterior satisfies the goal, when no plan found beats stopping there, after
+``max_replans`` replans, ``max_actions`` actions, or at the first action the executor could
+not carry out.
 
 The start belief of a replan depends on the semantics: ``particles`` plans from
 ``particles`` particles drawn from the posterior; ``deterministic`` from each of
@@ -32,7 +29,6 @@ resampling, the checks' rollouts, and the replans' seeds.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -57,7 +53,6 @@ __all__ = [
     "LoopOutcome",
     "Replan",
     "StepTrace",
-    "sign_test",
 ]
 
 
@@ -66,10 +61,7 @@ class ClosedLoopSettings:
     """How the loop senses, estimates and replans (module docstring).
 
     ``filter_particles`` is the belief's size; ``check_rollouts`` the rollouts of one success
-    estimate; ``threshold`` the estimate below which it replans; ``score_rollouts`` the
-    rollouts that confirm a low estimate and on which a replan's plans are compared with the
-    rest of the current plan, ``significance`` the sign test's level a plan must beat it at;
-    ``semantics``,
+    estimate; ``threshold`` the estimate below which it replans; ``semantics``,
     ``particles``, ``max_nodes`` and ``budget`` (seconds, for all of one replan's searches)
     configure a replan, ``candidates`` the start particles a ``deterministic`` replan plans
     from (the most central one, then others drawn from the posterior);
@@ -79,11 +71,9 @@ class ClosedLoopSettings:
     checks and the replans use that scale (:class:`~arrange_up.execution.belief.ParticleFilter`).
     """
 
-    filter_particles: int = 64
+    filter_particles: int = 256
     check_rollouts: int = 16
     threshold: float = 0.9
-    score_rollouts: int = 64
-    significance: float = 0.05
     semantics: str = "particles"
     particles: int = 10
     max_nodes: int = 300
@@ -215,8 +205,6 @@ class ClosedLoop:
                 found = self._replan(
                     belief, remaining, len(executed), estimate, episode, len(replans), rng
                 )
-                if found is None:  # the scoring rollouts find the goal met after all
-                    break
                 replans.append(found[0])
                 if not found[1]:  # nothing better than stopping here
                     stopped = "no plan"
@@ -246,10 +234,9 @@ class ClosedLoop:
                     found = self._replan(
                         belief, remaining, len(executed), estimate, episode, len(replans), rng
                     )
-                    if found is not None:  # else the scoring rollouts did not confirm it
-                        replans.append(found[0])
-                        if found[1] is not None:
-                            remaining = list(found[1])
+                    replans.append(found[0])
+                    if found[1] is not None:
+                        remaining = list(found[1])
             if trace:
                 steps.append(StepTrace(action, observation, update.predicted, belief, estimate))
         return LoopOutcome(
@@ -280,84 +267,40 @@ class ClosedLoop:
     def _plan_rate(
         self, belief: ParticleBelief, actions: Sequence[Action], rng: np.random.Generator
     ) -> float:
-        """The success rate of ``actions`` from ``belief`` over ``check_rollouts`` rollouts
-        (:meth:`_outcomes`); the goal's rate under ``belief`` when ``actions`` is empty."""
+        """The success rate of ``actions`` from ``belief`` over ``check_rollouts`` rollouts from
+        particles drawn from it (model noise, the rollouts' failures, then the goal test); the
+        goal's rate under ``belief`` when ``actions`` is empty."""
         if not actions:
             return self._goal_rate(belief)
-        return float(self._outcomes(belief, actions, rng, self.settings.check_rollouts).mean())
-
-    def _outcomes(
-        self,
-        belief: ParticleBelief,
-        actions: Sequence[Action],
-        rng: np.random.Generator,
-        rollouts: int,
-        among: Sequence[int] | None = None,
-    ) -> np.ndarray:
-        """Whether each of ``rollouts`` rollouts of ``actions`` succeeds: each from a particle
-        drawn from ``belief`` (from its particles ``among`` when given; the draws come first
-        from ``rng``, so two calls with equal generators start from the same particles), under
-        the model's noise, then the goal test. With no actions, whether each drawn particle
-        satisfies the goal."""
+        rollouts = Rollouts(self._model(), actions, landing=self.settings.landing)
         particles = belief.particles
-        indices = np.arange(len(particles)) if among is None else np.asarray(among)
-        picks = indices[rng.integers(0, len(indices), size=rollouts)]
-        if not actions:
-            return np.array([not self.goal.misses(particles[int(i)]) for i in picks])
-        runner = Rollouts(self._model(), actions, landing=self.settings.landing)
-        good = []
+        picks = rng.integers(0, len(particles), size=self.settings.check_rollouts)
+        good = 0
         for i in picks:
-            execution = runner.execute(particles[int(i)], rng)
-            good.append(execution.ok and not self.goal.misses(execution.state))
-        return np.array(good, dtype=bool)
+            execution = rollouts.execute(particles[int(i)], rng)
+            good += execution.ok and not self.goal.misses(execution.state)
+        return good / len(picks)
 
     # -- replanning --------------------------------------------------------------------------
-    def _split(
-        self, belief: ParticleBelief, rng: np.random.Generator
-    ) -> tuple[list[int], list[int]]:
-        """The posterior's particles (indices) a replan plans from, and those its plans are
-        scored on: the distinct states (resampling repeats particles) shuffled and halved,
-        the first half planned from and the second held out, so that a plan is not judged on
-        the very states it was made for. A CBST replan plans from the interval over every
-        particle and a posterior of one distinct state has nothing to hold out: both use
-        every particle then."""
-        particles = belief.particles
-        every = list(range(len(particles)))
-        groups: dict[Any, list[int]] = {}
-        for i, state in enumerate(particles):
-            groups.setdefault(state.poses, []).append(i)
-        if self.settings.semantics == "cbst" or len(groups) < 2:
-            return every, every
-        order = rng.permutation(len(groups))
-        keys = list(groups)
-        half = (len(keys) + 1) // 2
-        planned = sorted(i for k in order[:half] for i in groups[keys[int(k)]])
-        held = sorted(i for k in order[half:] for i in groups[keys[int(k)]])
-        return planned, held
-
-    def _starts(
-        self, belief: ParticleBelief, among: Sequence[int], rng: np.random.Generator
-    ) -> list[Any]:
-        """The replan's start beliefs, from the posterior's particles ``among``, in its
-        semantics' representation (module docstring)."""
+    def _starts(self, belief: ParticleBelief, rng: np.random.Generator) -> list[Any]:
+        """The replan's start beliefs in its semantics' representation (module docstring)."""
         s = self.settings
         if s.semantics == "cbst":
             return [belief.intervals]
         particles = belief.particles
-        among = list(among)
         if s.semantics == "deterministic":
             poses = belief.poses.reshape(len(belief), -1)
             spread = poses.std(axis=0) + 1e-9
-            distance = np.sum(((poses[among] - poses.mean(axis=0)) / spread) ** 2, axis=1)
-            central = among[int(np.argmin(distance))]
-            others = [i for i in among if i != central]
+            distance = np.sum(((poses - poses.mean(axis=0)) / spread) ** 2, axis=1)
+            central = int(np.argmin(distance))
+            others = [i for i in range(len(particles)) if i != central]
             count = min(s.candidates - 1, len(others))
             drawn = rng.choice(len(others), size=count, replace=False) if count else []
             chosen = [central, *(others[int(i)] for i in drawn)]
             return [ParticleBelief((particles[i],)) for i in chosen]
-        count = min(s.particles, len(among))
-        chosen = rng.choice(len(among), size=count, replace=False)
-        return [ParticleBelief(tuple(particles[among[int(i)]] for i in sorted(chosen)))]
+        count = min(s.particles, len(particles))
+        chosen = rng.choice(len(particles), size=count, replace=False)
+        return [ParticleBelief(tuple(particles[int(i)] for i in sorted(chosen)))]
 
     def _replan(
         self,
@@ -368,26 +311,16 @@ class ClosedLoop:
         episode: int,
         number: int,
         rng: np.random.Generator,
-    ) -> tuple[Replan, tuple[Action, ...] | None] | None:
-        """Split the posterior (:meth:`_split`), confirm the low ``estimate`` of the rest of
-        the plan on ``score_rollouts`` fresh rollouts from the held-out particles (None: not
-        confirmed, no replan), plan from the other particles within the budget, then keep the
-        best plan found if it beats the rest of the current plan significantly
-        (:func:`sign_test`): the record, and that plan (None: go on as before). Every
-        candidate and the current plan are scored on rollouts from the same held-out
-        particles (common random numbers), so the comparison is paired."""
+    ) -> tuple[Replan, tuple[Action, ...] | None]:
+        """Plan from the posterior within the budget, then keep the best plan found if it
+        beats the rest of the current plan: the record, and that plan (None: go on as
+        before). Every candidate and the current plan are scored on the same rollouts
+        (common random numbers), so the comparison is paired."""
         s = self.settings
         started = time.monotonic()
-        key = [self.seed, episode, number, 0xE57]
-        planned, held = self._split(belief, rng)
-        current = self._outcomes(
-            belief, remaining, np.random.default_rng(key), s.score_rollouts, held
-        )
-        if current.mean() >= s.threshold:
-            return None
         plans: list[tuple[Action, ...]] = []
         status = None
-        for k, start in enumerate(self._starts(belief, planned, rng)):
+        for k, start in enumerate(self._starts(belief, rng)):
             left = s.budget - (time.monotonic() - started)
             if left <= 0.0:
                 break
@@ -409,16 +342,12 @@ class ClosedLoop:
                     plans.append(result.actions or ())
             elif status is None:
                 status = str(result.status)
+        key = [self.seed, episode, number, 0xE57]
         best: tuple[Action, ...] | None = None
-        best_rate = float(current.mean())
+        best_rate = self._plan_rate(belief, remaining, np.random.default_rng(key))
         for candidate in plans:
-            outcomes = self._outcomes(
-                belief, candidate, np.random.default_rng(key), s.score_rollouts, held
-            )
-            rate = float(outcomes.mean())
-            wins = int(np.sum(outcomes & ~current))
-            losses = int(np.sum(current & ~outcomes))
-            if rate > best_rate and sign_test(wins, losses) < s.significance:
+            rate = self._plan_rate(belief, candidate, np.random.default_rng(key))
+            if rate > best_rate:
                 best, best_rate = candidate, rate
         record = Replan(
             after,
@@ -430,10 +359,3 @@ class ClosedLoop:
             best_rate,
         )
         return record, best
-
-
-def sign_test(wins: int, losses: int) -> float:
-    """One-sided sign test: the probability of at least ``wins`` wins in ``wins + losses``
-    paired trials that differ, were either side equally likely to win each (1.0 for none)."""
-    trials = wins + losses
-    return sum(math.comb(trials, k) for k in range(wins, trials + 1)) / 2.0**trials

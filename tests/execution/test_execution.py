@@ -25,7 +25,6 @@ from arrange_up.execution import (
     scaled_problem,
     sensor_for,
 )
-from arrange_up.execution.replanning import sign_test
 from arrange_up.io.domains import load
 from arrange_up.model.world import Place, Push, WorldState
 from arrange_up.physics.simulation import simulate
@@ -145,84 +144,6 @@ def test_a_truncated_plan_is_completed_by_replanning(blocks2):
     baseline = run_episodes(problem, short, sense="none", episodes=2, seed=0, settings=open_loop)
     assert baseline.reliability.successes == 0
     assert baseline.reliability.failures.goal_missed == 2
-
-
-def test_the_sign_test_is_the_binomial_tail():
-    assert sign_test(0, 0) == 1.0
-    assert sign_test(5, 0) == pytest.approx(1 / 32)
-    assert sign_test(3, 1) == pytest.approx(5 / 16)
-    assert sign_test(0, 4) == 1.0
-
-
-class _Scripted(ClosedLoop):
-    """A loop whose rollouts' outcomes are given per plan, to test the replan's rule alone."""
-
-    def __init__(self, problem, actions, outcomes):
-        super().__init__(problem, actions, sensor_for(problem, "none"))
-        self.scripted = outcomes
-
-    def _outcomes(self, belief, actions, rng, rollouts, among=None):
-        return np.array(self.scripted[tuple(actions)], dtype=bool)
-
-
-def _replan_with(monkeypatch, problem, current, candidate, outcomes):
-    class Found:
-        solved = True
-        actions = candidate
-        status = "solved"
-
-    calls = []
-    monkeypatch.setattr(
-        "arrange_up.execution.replanning.plan", lambda *a, **k: calls.append(k) or Found()
-    )
-    loop = _Scripted(problem, current, outcomes)
-    belief = ParticleFilter(problem, loop.sensor, 4, np.random.default_rng(0)).initial()
-    found = loop._replan(belief, current, 0, 0.5, 0, 0, np.random.default_rng(0))
-    return found, calls
-
-
-def test_a_replan_needs_a_confirmed_low_estimate_and_a_significant_win(blocks2, monkeypatch):
-    problem, actions = blocks2
-    current, candidate = tuple(actions[1:]), tuple(actions[2:])
-    # the scoring rollouts do not confirm the check's low estimate: no replan at all
-    found, calls = _replan_with(
-        monkeypatch, problem, current, candidate, {current: [True] * 60 + [False] * 4}
-    )
-    assert found is None and not calls
-    # confirmed (48 of 64), but the candidate wins 4 rollouts and loses none: p = 1/16
-    outcomes = {current: [True] * 48 + [False] * 16, candidate: [True] * 52 + [False] * 12}
-    found, calls = _replan_with(monkeypatch, problem, current, candidate, outcomes)
-    record, adopted = found
-    assert len(calls) == 1 and record.status == "solved" and record.plans == 1
-    assert adopted is None and record.adopted is None and record.adopted_estimate == 0.75
-    # five wins and none lost: p = 1/32, adopted
-    outcomes[candidate] = [True] * 53 + [False] * 11
-    record, adopted = _replan_with(monkeypatch, problem, current, candidate, outcomes)[0]
-    assert adopted == candidate and record.adopted == len(candidate)
-    assert record.adopted_estimate == pytest.approx(53 / 64)
-
-
-def test_a_replan_is_scored_on_other_states_than_it_plans_from(blocks2):
-    problem, actions = blocks2
-    executor = SimulatedExecutor(problem, sensor_for(problem, "none"), seed=0, episode=0)
-    states = []
-    for i, action in enumerate(actions[:3]):
-        executor.execute(action, i)
-        states.append(executor.state)
-    # a resampled posterior: three distinct states, repeated
-    belief = ParticleBelief(tuple(states[i % 3] for i in range(9)))
-    loop = ClosedLoop(problem, actions, sensor_for(problem, "paddle"))
-    planned, held = loop._split(belief, np.random.default_rng(0))
-    assert sorted(planned + held) == list(range(9))
-    planned_states = {belief.particles[i].poses for i in planned}
-    assert len(planned_states) == 2 and not planned_states & {
-        belief.particles[i].poses for i in held
-    }
-    (start,) = loop._starts(belief, planned, np.random.default_rng(0))
-    assert {p.poses for p in start.particles} <= planned_states
-    # one distinct state holds nothing out
-    single = ParticleBelief((states[0],) * 4)
-    assert loop._split(single, np.random.default_rng(0)) == ([0, 1, 2, 3], [0, 1, 2, 3])
 
 
 def test_episodes_resume_from_their_record(blocks2, tmp_path):
