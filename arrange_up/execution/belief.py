@@ -9,7 +9,7 @@ survivor predicts the observation noise-free (:meth:`Sensor.predict
 likelihood, then the particles are resampled (systematic resampling) back to the filter's
 count.
 
-The likelihood is the sensor's Gaussian widened by a kernel: a few dozen particles cannot
+The likelihood is the sensor's Gaussian widened by a kernel: a few hundred particles cannot
 represent a 0.01-inch encoder reading (almost none would land within its noise, and the
 weights would rest on one particle or none), so each component's variance is the sensor's
 plus the square of a kernel bandwidth, Silverman's rule on the spread of the predictions
