@@ -12,8 +12,9 @@ episodes (episode i's world drawn from (seed, i), noise ``--noise-scale`` times 
 run twice: open loop (the plan executed as it is: no replans, no sensing) and closed loop
 (``--sense``, replanning with ``--semantics`` / ``--particles`` / ``--max-nodes`` /
 ``--replan-budget``). The two rates are therefore paired. Every episode is appended to a
-``.jsonl`` record per problem and mode in ``--output-dir`` (re-running resumes), and the summary
-of each pair to ``closed_loop.json`` there (merged with the problems already in it).
+``.jsonl`` record per problem and mode in ``--output-dir`` (re-running resumes), the first
+plan to a plan file there (re-running reads it instead of planning again), and the summary of
+each pair to ``closed_loop.json`` there (merged with the problems already in it).
 """
 
 from __future__ import annotations
@@ -29,6 +30,12 @@ from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.io.domains import load
+from arrange_up.io.planfile import (
+    plan_document,
+    plan_problem_mismatch,
+    read_plan,
+    write_json_atomic,
+)
 from arrange_up.planning.planner import plan
 
 
@@ -75,13 +82,12 @@ def main(argv: list[str] | None = None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     for name in [p for p in args.problems.split(",") if p]:
         problem = load(name)
-        first = plan(
-            problem, semantics=args.plan_semantics, particles=args.plan_particles, seed=args.seed
-        )
-        if not first.solved:
-            print(f"{name}: no first plan ({first.reason})", flush=True)
+        tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
+        if args.plan_semantics == "particles":
+            tag += str(args.plan_particles)
+        actions = first_plan(problem, args, out / f"{tag}.plan.json")
+        if actions is None:
             continue
-        actions = first.actions or ()
         if args.distinct:
             distinct(problem, actions, args)
             continue
@@ -94,9 +100,6 @@ def main(argv: list[str] | None = None) -> int:
             landing=args.landing,
             adapt=not args.no_adapt,
         )
-        tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
-        if args.plan_semantics == "particles":
-            tag += str(args.plan_particles)
         if args.landing != "fail":
             tag += f".{args.landing}"
         row = {}
@@ -155,6 +158,37 @@ def main(argv: list[str] | None = None) -> int:
             flush=True,
         )
     return 0
+
+
+def first_plan(problem, args, path: Path) -> tuple | None:
+    """The first plan: read from ``path`` when an earlier run saved it there (a validated
+    particle plan of tt-mating-noisy takes minutes), else planned and saved; None (said) when
+    the planner found none."""
+    if path.exists():
+        actions, document = read_plan(path, problem)
+        mismatch = plan_problem_mismatch(document, problem)
+        if mismatch:
+            raise SystemExit(f"{path}: {mismatch}; delete it to plan again")
+        print(f"{problem.name}: first plan read from {path}", flush=True)
+        return actions
+    first = plan(
+        problem, semantics=args.plan_semantics, particles=args.plan_particles, seed=args.seed
+    )
+    if not first.solved:
+        print(f"{problem.name}: no first plan ({first.reason})", flush=True)
+        return None
+    actions = first.actions or ()
+    document = plan_document(
+        problem,
+        actions,
+        status=first.status,
+        semantics=first.semantics,
+        seed=args.seed,
+        search=first.stats,
+        extra={"particles": first.particles},
+    )
+    write_json_atomic(path, document)
+    return actions
 
 
 def distinct(problem, actions, args) -> None:
