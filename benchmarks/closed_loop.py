@@ -185,7 +185,10 @@ def first_plan(problem, args, path: Path) -> tuple | None:
         semantics=first.semantics,
         seed=args.seed,
         search=first.stats,
-        extra={"particles": first.particles},
+        extra={
+            "particles": first.particles,
+            **({"validation": first.validation.to_json()} if first.validation else {}),
+        },
     )
     write_json_atomic(path, document)
     return actions
