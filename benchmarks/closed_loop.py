@@ -5,6 +5,8 @@
     python benchmarks/closed_loop.py --problems tz-mating,create-a-t --episodes 200 --output-dir out
     python benchmarks/closed_loop.py --problems create-a-t --plan-semantics particles \
         --plan-particles 25 --episodes 200 --distinct
+    python benchmarks/closed_loop.py --problems blocks-4@servo --noise-scale 2 \
+        --plan-semantics cbst --semantics cbst
 
 For each problem: a first plan (``--plan-semantics``: ``deterministic`` gives the nominal plan,
 the open-loop comparator of the mating problems; ``particles`` a particle plan), then the same
@@ -36,12 +38,18 @@ from arrange_up.io.planfile import (
     read_plan,
     write_json_atomic,
 )
+from arrange_up.model.problem import driven_by
 from arrange_up.planning.planner import plan
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--problems", default="tz-mating")
+    parser.add_argument(
+        "--problems",
+        default="tz-mating",
+        help="Comma-separated problem names; NAME@CONTROLLER runs a problem under that "
+        "controller (blocks-4@servo: the servo, whose CBST model plans it).",
+    )
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--sense", default="paddle")
@@ -81,7 +89,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     out.mkdir(parents=True, exist_ok=True)
     for name in [p for p in args.problems.split(",") if p]:
-        problem = load(name)
+        base, _, controller = name.partition("@")
+        problem = driven_by(load(base), controller) if controller else load(base)
         tag = f"{name}.{args.sense}.x{args.noise_scale:g}.{args.plan_semantics}"
         if args.plan_semantics == "particles":
             tag += str(args.plan_particles)
@@ -281,6 +290,8 @@ def table(out: Path) -> str:
         s = header["settings"]
         if s["semantics"] == "deterministic":
             how = f"deterministic from {s.get('candidates', 1)} particles"
+        elif s["semantics"] == "cbst":
+            how = "cbst from the posterior's intervals"
         else:
             how = f"{s['semantics']}, {s['particles']} particles"
         how += f", {s['max_nodes']} nodes, {s['budget']:g} s"

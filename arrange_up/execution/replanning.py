@@ -94,8 +94,11 @@ class Replan:
     """One replan: after ``after`` actions, triggered by the success ``estimate``; the
     planner's ``status`` (``solved`` when any start gave a plan), the wall-clock ``seconds``
     of the whole replan (planning and scoring the candidates), the distinct ``plans`` found,
-    the length of the plan adopted (None: no plan beat the current one, which goes on), and
-    the estimated success of what goes on (``adopted_estimate``)."""
+    the length of the plan adopted (None: no plan beat the current one, which goes on), the
+    estimated success of what goes on (``adopted_estimate``), and when no start gave a plan,
+    the planner's line on why (:attr:`~arrange_up.planning.planner.PlanResult.reason` of the
+    first search; None when a plan was found, when the budget ran out before any search, and
+    in records written before it was kept)."""
 
     after: int
     estimate: float
@@ -104,6 +107,7 @@ class Replan:
     plans: int
     adopted: int | None
     adopted_estimate: float
+    reason: str | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
@@ -119,6 +123,7 @@ class Replan:
             int(data["plans"]),
             None if adopted is None else int(adopted),
             float(data["adopted_estimate"]),
+            data.get("reason"),
         )
 
 
@@ -319,7 +324,7 @@ class ClosedLoop:
         s = self.settings
         started = time.monotonic()
         plans: list[tuple[Action, ...]] = []
-        status = None
+        status = reason = None
         for k, start in enumerate(self._starts(belief, rng)):
             left = s.budget - (time.monotonic() - started)
             if left <= 0.0:
@@ -341,7 +346,7 @@ class ClosedLoop:
                 if result.actions not in plans:
                     plans.append(result.actions or ())
             elif status is None:
-                status = str(result.status)
+                status, reason = str(result.status), result.reason
         key = [self.seed, episode, number, 0xE57]
         best: tuple[Action, ...] | None = None
         best_rate = self._plan_rate(belief, remaining, np.random.default_rng(key))
@@ -357,5 +362,6 @@ class ClosedLoop:
             len(plans),
             None if best is None else len(best),
             best_rate,
+            None if status == "solved" else reason,
         )
         return record, best

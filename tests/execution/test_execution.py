@@ -19,6 +19,7 @@ from arrange_up.execution import (
     Executor,
     Observation,
     ParticleFilter,
+    Replan,
     SimulatedExecutor,
     intersect_intervals,
     run_episodes,
@@ -144,6 +145,22 @@ def test_a_truncated_plan_is_completed_by_replanning(blocks2):
     baseline = run_episodes(problem, short, sense="none", episodes=2, seed=0, settings=open_loop)
     assert baseline.reliability.successes == 0
     assert baseline.reliability.failures.goal_missed == 2
+
+
+def test_a_replan_that_finds_no_plan_records_the_planners_reason(blocks2):
+    problem, actions = blocks2
+    settings = ClosedLoopSettings(
+        filter_particles=16, check_rollouts=4, particles=5, max_nodes=1, max_replans=1
+    )
+    short = actions[: len(actions) // 2]
+    [episode] = run_episodes(problem, short, episodes=1, seed=0, settings=settings).episodes
+    [replan] = episode.replans
+    assert replan.status == "node-limit" and replan.plans == 0
+    assert replan.reason.startswith("node-limit after 1 node")
+    assert Replan.from_json(replan.to_json()) == replan
+    # records written before the reason was kept read back without one
+    older = {k: v for k, v in replan.to_json().items() if k != "reason"}
+    assert Replan.from_json(older).reason is None
 
 
 def test_episodes_resume_from_their_record(blocks2, tmp_path):
