@@ -8,7 +8,9 @@ default step is the growth of the part's place shadow over its nominal footprint
 just enough for the place precondition to hold next to walls and neighbours, and no more,
 since every extra inch must be pushed and pushing accrues uncertainty. The angle is the
 target's (``planning.place_angles`` adds alternatives). For a relative goal the target is the
-goal pose composed with the reference part's current belief centre.
+goal pose composed with the reference part's current belief centre; the reference itself, when
+it starts off the table, is placed about :attr:`~arrange_up.planning.mating.Mates.home` (its
+goal is anywhere: there, the goal arrangement is centred on the table).
 
 **Push** (Figure 2-11): "object-centric" pushes. For every part on the table and every axis
 direction (``planning.push_directions`` restricts them), the manipulator is put behind the
@@ -309,8 +311,12 @@ class ActionGenerator:
 
     # -- place -----------------------------------------------------------------------------
     def place_target(self, name: str, belief: IntervalBelief) -> Pose | None:
-        """Where ``name`` should end according to the goal, given ``belief`` (None if unknown)."""
+        """Where ``name`` should end according to the goal, given ``belief`` (None if unknown);
+        for a relative goal's reference off the table, where to put it down
+        (:attr:`Mates.home`: its goal is anywhere)."""
         goal = self.problem.goal
+        if name == goal.reference and name not in belief:
+            return self.mates.home
         if name not in goal.parts:
             return None
         target = goal.target(name)

@@ -41,6 +41,11 @@ the generator presses it against the wall ahead, centred and as a turning push o
 (:mod:`arrange_up.planning.actions`), which turns it flat against the wall
 (m-rotated-reference-pair's bar, turned 30 degrees +-5, its mates 8.5 cm away with +-8 mm).
 
+Fourth, where to put the reference down when it starts off the table (:attr:`Mates.home`): its
+goal lets it end anywhere, so the goal gives no place; it is placed (with the usual grid of
+offsets) where the goal arrangement, the reference and its mates at their targets, is centred
+on the table, which leaves the most room around it for the mates' places and pushes.
+
 Nothing of this is offered for an absolute goal, whose parts are seated against walls, fences
 and the trains of parts ahead of them instead.
 """
@@ -49,6 +54,8 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+
+import shapely
 
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem, Pose
@@ -79,6 +86,8 @@ class Mates:
         )
         self._parts = {spec.name: spec.shape.parts for spec in problem.parts}
         self._ahead = lru_cache(maxsize=50_000)(self._ahead_uncached)
+        #: Where the reference is placed when it starts off the table (:meth:`home`).
+        self.home = self._home(problem) if goal.reference is not None else None
 
     def __bool__(self) -> bool:
         return self.reference is not None
@@ -111,6 +120,22 @@ class Mates:
         turned = self._lever * math.sin(min(half[2], 0.5 * math.pi))
         tolerance = min(self._tolerance[0], self._tolerance[1])
         return max(half[0], half[1]) <= tolerance < max(half[0], half[1]) + turned
+
+    def _home(self, problem: ArrangementProblem) -> Pose:
+        """The reference's pose (at angle 0, the frame its mates' targets are given in) that
+        centres the goal arrangement, the reference and every mate at its target by their
+        nominal footprints, on the table: a goal that lets the reference end anywhere gives
+        no place to put it down, and the middle of the table leaves the most room around the
+        arrangement for the places and pushes of its mates."""
+        shapes = [footprint(self._parts[self.reference], (0.0, 0.0, 0.0))]
+        shapes += [
+            footprint(self._parts[name], pose)
+            for name, pose in problem.goal.targets
+            if name != self.reference
+        ]
+        x0, y0, x1, y1 = shapely.union_all(shapes).bounds
+        width, depth = problem.table.size
+        return (0.5 * width - 0.5 * (x0 + x1), 0.5 * depth - 0.5 * (y0 + y1), 0.0)
 
     def _ahead_uncached(self, name, target, mate, axis, sign) -> bool:
         other = footprint(self._parts[self.reference], mate)

@@ -13,7 +13,7 @@ import arrange_up
 from arrange_up.belief.goals import GoalTest
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.yaml_problem import load_problem
-from arrange_up.model.world import Push
+from arrange_up.model.world import Place, Push
 
 FRESH = Path(__file__).parents[1] / "problems" / "fresh"
 
@@ -38,6 +38,20 @@ def test_a_relative_pair_plans_once_its_reference_has_moved_from_the_edge():
     result = arrange_up.plan(problem, particles=10, workers=1)
     assert result.solved, result.reason
     assert isinstance(result.actions[0], Push)  # A makes room before B is placed
+
+
+def test_a_reference_that_starts_off_the_table_is_put_down_with_room_for_its_mates():
+    # Its goal is anywhere; it is placed where the goal arrangement is centred on the table.
+    problem = load_problem(FRESH / "reference-off-table.yaml")
+    result = arrange_up.plan(problem, particles=5, workers=1, validate=0)
+    assert result.solved, result.reason
+    first = result.actions[0]
+    assert isinstance(first, Place) and first.obj == "R"
+    # R (2 x 1) with C on top spans y -0.5..1.55 in R's frame: centred on the 9 x 7 table, R's
+    # centre is at (4.5, 2.975), give or take one step of the place grid
+    assert abs(first.pose[0] - 4.5) <= 1.0 and abs(first.pose[1] - 2.975) <= 1.0
+    final = result.beliefs[-1]
+    assert GoalTest(problem).satisfied_array(final.poses, final.names())
 
 
 def _centres(result, name: str) -> list[tuple[float, float]]:
