@@ -136,6 +136,10 @@ class PlanResult:
     in); for ``unsolvable``, the parts that cannot fit on the table (``off table``).
     ``refusals``: ``(reason, count)`` of the candidates the semantics refused, most frequent
     first, for a semantics that says why (CBST's ``reasons``; empty otherwise).
+    ``unplaceable`` (empty when solved): the parts off the table that have a place target at the
+    search's start but no place candidate there, every one failing the place precondition
+    (their shadow must keep clear of walls, obstacles and the parts on the table: a part that
+    fits its goal only touching them is never placed).
     ``validation`` (None when the plan was not validated): how the plan, and each search, did
     on fresh rollouts (the ``validate`` argument of :func:`plan`). Of a validated run,
     ``statistics`` are those of the search whose plan is returned, but ``elapsed`` is the
@@ -153,6 +157,7 @@ class PlanResult:
     misses: tuple[PartMiss, ...] | None = None
     refusals: tuple[tuple[str, int], ...] = ()
     validation: Validation | None = None
+    unplaceable: tuple[str, ...] = ()
 
     @property
     def solved(self) -> bool:
@@ -191,6 +196,11 @@ class PlanResult:
                 for m in self.misses
             )
             line += f"; the best belief still misses {missed}"
+        if self.unplaceable:
+            line += (
+                f"; no place of {', '.join(self.unplaceable)} is clear (a placed part's shadow "
+                "must keep clear of the walls, obstacles and parts on the table)"
+            )
         return line
 
     @property
@@ -466,12 +476,13 @@ def _search(
             progress(SearchSnapshot.of(stats, evaluator.simulations).to_json())
 
     oversized = too_large(problem)
+    start_belief = task.initial_belief()
     try:
         # A goal part that cannot fit on the table is a proof: no search is needed.
         result = SearchResult(SearchStatus.UNSOLVABLE, None, None, None, SearchStats())
         if not oversized:
             result = best_first_search(
-                task.initial_belief(),
+                start_belief,
                 evaluator.successors,
                 task.is_goal,
                 evaluator.heuristic,
@@ -491,6 +502,7 @@ def _search(
     finally:
         evaluator.close()
         task.close()
+    misses = _misses(task, result, oversized, start_belief)
     statistics = PlanStatistics(
         **{
             **asdict(SearchSnapshot.of(result.stats, evaluator.simulations)),
@@ -509,21 +521,44 @@ def _search(
         particles=task.semantics.particles,
         statistics=statistics,
         beliefs=tuple(result.states) if result.states is not None else None,
-        misses=_misses(task, result, oversized),
+        misses=misses,
         refusals=tuple(getattr(task.semantics, "reasons", Counter()).most_common()),
+        unplaceable=_unplaceable(task, start_belief, misses),
     )
 
 
 def _misses(
-    task: BeliefTask, result: SearchResult, oversized: tuple[str, ...]
+    task: BeliefTask, result: SearchResult, oversized: tuple[str, ...], start: Any
 ) -> tuple[PartMiss, ...] | None:
     """:attr:`PlanResult.misses` of ``result``: the oversized parts (proven unsolvable), how the
-    best belief misses the goal, or None (solved, or no belief was accepted)."""
+    best belief misses the goal, the ``start`` belief's misses when the search accepted no
+    belief (the ordering filter pruned the start), or None (solved)."""
     if oversized:
         return tuple(PartMiss(p, True, (0.0, 0.0, 0.0)) for p in oversized)
-    if result.solved() or result.best is None:
+    if result.solved():
         return None
-    return task.goal.misses_array(result.best.poses, result.best.names())
+    best = start if result.best is None else result.best
+    return task.goal.misses_array(best.poses, best.names())
+
+
+def _unplaceable(
+    task: BeliefTask, start: Any, misses: tuple[PartMiss, ...] | None
+) -> tuple[str, ...]:
+    """:attr:`PlanResult.unplaceable`: of the parts ``misses`` has off the table, those that
+    have a place target at ``start`` but no place candidate there (each fails the place
+    precondition)."""
+    missing = [m.part for m in misses or () if m.missing]
+    if not missing:
+        return ()
+    intervals = start.intervals
+    placed = {action.obj for action in task.generator.places(intervals)}
+    return tuple(
+        name
+        for name in missing
+        if name not in intervals
+        and name not in placed
+        and task.generator.place_target(name, intervals) is not None
+    )
 
 
 def too_large(problem: ArrangementProblem) -> tuple[str, ...]:

@@ -215,6 +215,36 @@ goal:
 """
 
 
+EXACT_FIT = """
+name: exact-fit
+table: {size: [2, 1]}
+objects:
+  A: {kind: part, shape: {box: [1, 1]}}
+  B: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [0.9, 0.1]}}
+goal:
+  tolerance: [0.1, 0.1, 10]
+  poses: {A: [0.5, 0.5, 0], B: [1.5, 0.5, 0]}
+"""
+
+
+def test_parts_that_fit_only_touching_the_walls_are_named_as_never_placed():
+    # Two blocks that fill the walled table exactly: no place keeps its shadow clear of the
+    # walls (touching counts as a collision), so the ordering filter prunes the start belief.
+    problem, _ = check_problem_text(EXACT_FIT, "exact-fit")
+    result = plan(problem, semantics="deterministic", workers=1)
+    assert result.status is SearchStatus.EXHAUSTED and result.stats["expanded"] == 0
+    assert result.unplaceable == ("A", "B")
+    assert result.reason.endswith(
+        "the best belief still misses A (not on the table), B (not on the table); no place of "
+        "A, B is clear (a placed part's shadow must keep clear of the walls, obstacles and "
+        "parts on the table)"
+    )
+    # With room to spare the parts are placed, and nothing is said of places.
+    roomy, _ = check_problem_text(EXACT_FIT.replace("[2, 1]}", "[2.2, 1.2]}"), "roomy")
+    assert plan(roomy, semantics="deterministic", workers=1).solved
+
+
 def test_a_search_that_runs_out_of_candidates_is_exhausted_and_says_why():
     result = plan(servo(tiny("obstacle")), particles=5, workers=1)
     assert result.status is SearchStatus.EXHAUSTED and result.status == "exhausted"
