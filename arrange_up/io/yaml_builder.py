@@ -327,10 +327,14 @@ class ProblemBuilder(NodeReader):
         for key_node, value_node in node.entries():
             name = key_node.value
             if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
-                shown = repr(name) if isinstance(name, str) else describe(name)
+                got = (
+                    f"invalid object name {name!r}"
+                    if isinstance(name, str)
+                    else (f"an object name must be a string, got {describe(name)}")
+                )
                 self.error(
                     key_node,
-                    f"invalid object name {shown}; expected an identifier: letters, digits, "
+                    f"{got}; expected an identifier: letters, digits, "
                     "'_' and '-', starting with a letter or '_'",
                 )
                 if not isinstance(name, str):

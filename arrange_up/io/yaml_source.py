@@ -15,7 +15,7 @@ import difflib
 import math
 import re
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -291,9 +291,9 @@ def describe(value: Any) -> str:
         return f"{str(value)!r} (a string)"
     if isinstance(value, int | float):
         return f"the number {value}"
-    if isinstance(value, dict):
+    if isinstance(value, Mapping):
         return "a mapping"
-    if isinstance(value, list):
+    if isinstance(value, list | tuple):  # a tuple: a list used as a mapping key
         return "a list"
     return f"a {type(value).__name__} value"
 

@@ -38,7 +38,7 @@ import bisect
 import gc
 import re
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -164,7 +164,17 @@ class Document:
 
 
 def join(path: str, key: Any) -> str:
-    return f"{path}.{key}" if path else str(key)
+    """The key path of ``key`` under ``path``; a complex key (a YAML list or mapping used as a
+    key, which reaches here as a tuple or mapping) is written in YAML's flow style."""
+    return f"{path}.{_key_text(key)}" if path else _key_text(key)
+
+
+def _key_text(key: Any) -> str:
+    if isinstance(key, tuple):
+        return "[" + ", ".join(_key_text(k) for k in key) + "]"
+    if isinstance(key, Mapping):
+        return "{" + ", ".join(f"{_key_text(k)}: {_key_text(v)}" for k, v in key.items()) + "}"
+    return str(key)
 
 
 def read(text: str) -> Document | None:

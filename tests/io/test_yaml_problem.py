@@ -941,6 +941,32 @@ def test_refuses_an_invalid_object_name(tmp_path: Path) -> None:
     assert len(errors) == 1  # the goal naming it does not cascade
 
 
+def test_refuses_a_list_or_a_mapping_as_an_object_name_naming_it_in_flow_style(
+    tmp_path: Path,
+) -> None:
+    complex_keys = (
+        "      ? [B, C]\n      : {kind: part, shape: {box: [1, 1]}}\n"
+        "      ? {b: 1}\n      : {kind: part, shape: {box: [1, 1]}}\n"
+    )
+    path = write(tmp_path, MINIMAL.replace("    goal:", complex_keys + "    goal:"))
+    first, second = errors_of(path)
+    assert_diagnostic(
+        first,
+        path,
+        where(path, "[B, C]"),
+        "objects.[B, C]",
+        "an object name must be a string, got a list",
+        "expected an identifier",
+    )
+    assert_diagnostic(
+        second,
+        path,
+        where(path, "{b: 1}"),
+        "objects.{b: 1}",
+        "an object name must be a string, got a mapping",
+    )
+
+
 def test_refuses_an_obstacle_without_a_pose(tmp_path: Path) -> None:
     path = write(
         tmp_path,
