@@ -110,11 +110,12 @@ def parse(text: str, report: Report) -> YamlMap | None:
         report.error(None, "", f"not valid YAML: {_one_line(str(error))}")
         return None
     except RecursionError:
+        line, column, depth = deepest(text)
         report.error(
-            None,
+            (line, column),
             "",
-            "not a problem file: the YAML is nested too deeply; expected a mapping of the "
-            "format's sections (name, table, objects, goal, ...)",
+            f"not a problem file: the YAML is nested too deeply ({depth} levels here); "
+            "expected a mapping of the format's sections (name, table, objects, goal, ...)",
         )
         return None
     except ValueError as error:  # an integer of more digits than Python converts
@@ -167,6 +168,41 @@ def long_number(text: str) -> tuple[int | None, int | None, int]:
     before = text[: match.start()]
     line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
     return line, column, len(match.group(0))
+
+
+def deepest(text: str) -> tuple[int, int, int]:
+    """``(line, column, depth)`` of the first place where ``text`` is nested deepest: the
+    bracket that opens its deepest level of flow collections (``[`` and ``{``, outside quoted
+    scalars and comments), or, where block indentation nests deeper than that, the first line
+    of the largest indentation (its depth counted in indentation steps of two spaces)."""
+    depth = best = 0
+    where = (1, 1)
+    quote = ""
+    for number, line in enumerate(text.splitlines(), start=1):
+        for index, char in enumerate(line):
+            if quote:
+                if char == quote:
+                    quote = ""
+            elif char in "'\"":
+                quote = char
+            elif char == "#" and (index == 0 or line[index - 1] in " \t"):
+                break
+            elif char in "[{":
+                depth += 1
+                if depth > best:
+                    best, where = depth, (number, index + 1)
+            elif char in "]}" and depth:
+                depth -= 1
+    indents = [
+        (len(line) - len(line.lstrip(" ")), number)
+        for number, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if indents:
+        indent, number = max(indents, key=lambda pair: (pair[0], -pair[1]))
+        if indent // 2 > best:
+            return number, indent + 1, indent // 2
+    return where[0], where[1], best
 
 
 # ---------------------------------------------------------------------------------------------

@@ -17,6 +17,7 @@ from arrange_up.io.yaml_problem import (
     load_problem,
     load_problem_text,
 )
+from arrange_up.io.yaml_source import deepest
 from arrange_up.model.errors import Diagnostic, ProblemFormatError
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, PlanningHints, Uncertainty
 from arrange_up.model.units import Units
@@ -965,6 +966,25 @@ def test_refuses_a_list_or_a_mapping_as_an_object_name_naming_it_in_flow_style(
         "objects.{b: 1}",
         "an object name must be a string, got a mapping",
     )
+
+
+def test_a_file_nested_too_deeply_to_read_is_refused_where_it_nests_deepest(
+    tmp_path: Path,
+) -> None:
+    levels = 1000  # deeper than the parser's recursion reaches
+    path = tmp_path / "deep.yaml"
+    path.write_text(f"name: d\ntable: {{size: [10, 5]}}\nobjects: {'[' * levels}{']' * levels}\n")
+    [error] = errors_of(path)
+    assert (error.line, error.column) == (3, len("objects: ") + levels)
+    assert f"nested too deeply ({levels} levels here)" in error.message
+
+
+def test_the_deepest_place_of_a_text_is_its_deepest_bracket_or_indentation() -> None:
+    assert deepest("a:\n  b:\n    c: [1, {d: [2]}]\n") == (3, 16, 3)
+    # brackets in quoted scalars and comments do not nest
+    assert deepest('a: "[[[["\n# [[[[[\nb: [1]\n') == (3, 4, 1)
+    nested = "a:\n" + "".join("  " * i + f"k{i}:\n" for i in range(1, 9)) + "  " * 9 + "v: 1\n"
+    assert deepest(nested) == (10, 19, 9)
 
 
 def test_refuses_an_obstacle_without_a_pose(tmp_path: Path) -> None:
