@@ -327,11 +327,10 @@ class ProblemBuilder(NodeReader):
         for key_node, value_node in node.entries():
             name = key_node.value
             if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
-                got = (
-                    f"invalid object name {name!r}"
-                    if isinstance(name, str)
-                    else (f"an object name must be a string, got {describe(name)}")
-                )
+                if isinstance(name, str):
+                    got = f"invalid object name {name!r}"
+                else:
+                    got = f"an object name must be a string, got {describe(name)}"
                 self.error(
                     key_node,
                     f"{got}; expected an identifier: letters, digits, "

@@ -86,7 +86,7 @@ class Mates:
         )
         self._parts = {spec.name: spec.shape.parts for spec in problem.parts}
         self._ahead = lru_cache(maxsize=50_000)(self._ahead_uncached)
-        #: Where the reference is placed when it starts off the table (:meth:`home`).
+        #: Where the reference is placed when it starts off the table (:meth:`_home`).
         self.home = self._home(problem) if goal.reference is not None else None
 
     def __bool__(self) -> bool:

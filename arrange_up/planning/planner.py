@@ -198,8 +198,8 @@ class PlanResult:
             line += f"; the best belief still misses {missed}"
         if self.unplaceable:
             line += (
-                f"; no place of {', '.join(self.unplaceable)} is clear (a placed part's shadow "
-                "must keep clear of the walls, obstacles and parts on the table)"
+                f"; no place of {', '.join(self.unplaceable)} is clear at the start (a placed "
+                "part's shadow must keep clear of the walls, obstacles and parts on the table)"
             )
         return line
 
@@ -476,8 +476,8 @@ def _search(
             progress(SearchSnapshot.of(stats, evaluator.simulations).to_json())
 
     oversized = too_large(problem)
-    start_belief = task.initial_belief()
     try:
+        start_belief = task.initial_belief()
         # A goal part that cannot fit on the table is a proof: no search is needed.
         result = SearchResult(SearchStatus.UNSOLVABLE, None, None, None, SearchStats())
         if not oversized:

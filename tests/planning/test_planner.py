@@ -237,8 +237,8 @@ def test_parts_that_fit_only_touching_the_walls_are_named_as_never_placed():
     assert result.unplaceable == ("A", "B")
     assert result.reason.endswith(
         "the best belief still misses A (not on the table), B (not on the table); no place of "
-        "A, B is clear (a placed part's shadow must keep clear of the walls, obstacles and "
-        "parts on the table)"
+        "A, B is clear at the start (a placed part's shadow must keep clear of the walls, "
+        "obstacles and parts on the table)"
     )
     # With room to spare the parts are placed, and nothing is said of places.
     roomy, _ = check_problem_text(EXACT_FIT.replace("[2, 1]}", "[2.2, 1.2]}"), "roomy")
