@@ -28,7 +28,7 @@ from typing import Any
 
 from arrange_up.belief.states import AngleFrame
 from arrange_up.evaluation.outcomes import Failure, RolloutRecord
-from arrange_up.evaluation.records import RecordFileError, plan_hash
+from arrange_up.evaluation.records import RecordFileError, plan_hash, recorded_lines
 from arrange_up.evaluation.reliability import FailureBreakdown, Reliability
 from arrange_up.execution.belief import ModelFailure
 from arrange_up.execution.executor import SimulatedExecutor
@@ -231,23 +231,19 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
     if not lock_exclusively(handle):
         handle.close()
         raise RecordFileError(f"{path}: the record file is in use by another run")
-    handle.seek(0)
-    data = handle.read()
-    if data and not data.endswith(b"\n"):
-        # the last line was cut off (a run killed while writing): drop it, run it again
-        data = data[: data.rfind(b"\n") + 1]
-        handle.truncate(len(data))
-    lines = [line for line in data.split(b"\n") if line.strip()]
+    try:
+        # a last line cut off by a killed run is dropped (its episode runs again)
+        lines = recorded_lines(handle, path, EPISODES_FORMAT, "an arrange-up episode record")
+        lines = [line for line in lines if line.strip()]
+    except RecordFileError:
+        handle.close()
+        raise
     episodes: dict[int, EpisodeRecord] = {}
     if not lines:
-        handle.truncate(0)
         handle.write(json.dumps(header).encode() + b"\n")
         handle.flush()
         return handle, episodes
-    try:
-        found = json.loads(lines[0])
-    except ValueError:
-        found = None
+    found = json.loads(lines[0])
     if found != json.loads(json.dumps(header)):
         handle.close()
         raise RecordFileError(

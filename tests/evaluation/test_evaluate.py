@@ -350,6 +350,30 @@ def test_a_record_of_another_evaluation_is_refused(blocks1, tmp_path):
         evaluate_plan(problem, actions, rollouts=2, workers=1, record=record)
 
 
+def test_a_file_that_is_not_a_record_is_refused_untouched_even_without_a_final_newline(
+    blocks1, tmp_path
+):
+    # A file without a final newline looks like a record whose last line a kill cut off;
+    # that line is dropped only once the file's header shows it is a record of this kind.
+    problem, actions = blocks1
+    for name, text in (
+        ("plan.json", '{"format":"arrange-up-plan/1","actions":[]}'),  # one line, no newline
+        ("notes.txt", "first line\nsecond line"),
+        ("garbage.json", "not json at all"),
+    ):
+        path = tmp_path / name
+        path.write_text(text)
+        with pytest.raises(RecordFileError, match="not an arrange-up rollout record"):
+            evaluate_plan(problem, actions, rollouts=2, workers=1, record=path)
+        assert path.read_text() == text
+    # the start of a header a kill cut off is a record begun: it starts afresh
+    begun = tmp_path / "begun.jsonl"
+    begun.write_text('{"format":"arrange-up-rol')
+    result = evaluate_plan(problem, actions, rollouts=2, workers=1, record=begun)
+    assert result == evaluate_plan(problem, actions, rollouts=2, workers=1)
+    assert len(_lines(begun)) == 3
+
+
 def test_a_record_in_use_is_refused(blocks1, tmp_path):
     problem, actions = blocks1
     record = tmp_path / "busy.jsonl"

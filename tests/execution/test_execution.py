@@ -183,6 +183,12 @@ def test_episodes_resume_from_their_record(blocks2, tmp_path):
     other = ClosedLoopSettings(filter_particles=9)
     with pytest.raises(ValueError, match="another closed-loop run"):
         run_episodes(problem, actions, episodes=1, seed=1, settings=other, record=record)
+    # a file that is not an episode record is refused and left as it was, newline or not
+    notes = tmp_path / "notes.json"
+    notes.write_text('{"format": "arrange-up-plan/1"}')
+    with pytest.raises(ValueError, match="not an arrange-up episode record"):
+        run_episodes(problem, actions, episodes=1, seed=1, settings=settings, record=notes)
+    assert notes.read_text() == '{"format": "arrange-up-plan/1"}'
 
 
 def test_an_action_the_executor_cannot_carry_out_ends_the_episode(blocks2):
