@@ -118,16 +118,21 @@ class CsvAppender:
 
     def _open(self) -> None:
         self.handle.seek(0)
-        text = self.handle.read().decode("utf-8")
+        data = self.handle.read()
+        text = data.decode("utf-8", errors="replace")
         whole = _whole_lines(text)
-        if whole != text:  # a run killed while writing a row: drop the cut-off line
-            self.handle.truncate(len(whole.encode("utf-8")))
         rows = list(csv.reader(io.StringIO(whole, newline="")))
-        if rows and rows[0] != self.fields:
+        # The columns are checked before anything is dropped: a file that is not this
+        # experiment's CSV is refused untouched, with or without a final newline.
+        header = ",".join(self.fields)
+        if rows and rows[0] != self.fields or not rows and not header.startswith(text.strip()):
+            found = ", ".join(rows[0]) if rows else text.strip()[:60]
             raise CsvRecordsError(
-                f"{self.path}: its columns ({', '.join(rows[0])}) are not this experiment's "
+                f"{self.path}: its columns ({found}) are not this experiment's "
                 f"({', '.join(self.fields)}); write to another output directory"
             )
+        if whole != text:  # a run killed while writing a row: drop the cut-off line
+            self.handle.truncate(len(whole.encode("utf-8")))
         self._check_settings(has_rows=len(rows) > 1)
         self.writer = csv.DictWriter(_Text(self.handle), self.fields)
         if not rows:

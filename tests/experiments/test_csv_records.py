@@ -31,6 +31,22 @@ def _appender(path: Path, settings=SETTINGS) -> CsvAppender:
     return CsvAppender(path, FIELDS, key=KEY, settings=settings)
 
 
+def test_a_file_that_is_not_this_csv_is_refused_untouched_even_without_a_final_newline(
+    tmp_path: Path,
+):
+    for text in ("one line of notes", "a,b\n1,2", "\xff\xfe binary"):
+        path = tmp_path / "t.csv"
+        path.write_text(text, encoding="latin-1")
+        with pytest.raises(CsvRecordsError, match="are not this experiment's"), _appender(path):
+            pass
+        assert path.read_text(encoding="latin-1") == text
+    # the start of the header a kill cut off is a CSV begun: it starts afresh
+    path.write_text("problem,ru")
+    with _appender(path) as write:
+        write({"problem": "p", "run": 0, "value": 1.5})
+    assert path.read_text().splitlines() == ["problem,run,value", "p,0,1.5"]
+
+
 def test_rows_are_appended_resumed_and_settings_kept(tmp_path: Path):
     path = tmp_path / "t.csv"
     with _appender(path) as write:
