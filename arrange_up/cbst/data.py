@@ -75,6 +75,7 @@ import numpy as np
 from arrange_up.cbst.contact_graph import MIN_OVERLAP, MIN_OVERLAP_PADDLE, PUSH_MARGIN
 from arrange_up.cbst.features import Domain, feature_row
 from arrange_up.geometry.shapes import shadow_box
+from arrange_up.io.files import recorded_lines
 from arrange_up.model.problem import (
     ArrangementProblem,
     Controller,
@@ -437,19 +438,16 @@ def _read_records(path: Path) -> list[dict[str, Any]]:
     from the file."""
     if not path.exists():
         return []
-    raw = path.read_bytes()
-    if raw and not raw.endswith(b"\n"):
-        cut = raw.rfind(b"\n") + 1
-        with path.open("r+b") as fh:
-            fh.truncate(cut)
-        raw = raw[:cut]
+    with path.open("r+b") as fh:
+        # a file of another kind is refused untouched (its first line is no data record)
+        lines = recorded_lines(fh, path, DATA_FORMAT, "a CBST data file")
     records = []
-    for number, line in enumerate(raw.decode("utf-8").splitlines(), 1):
+    for number, line in enumerate(lines, 1):
         if not line.strip():
             continue
         try:
             records.append(json.loads(line))
-        except json.JSONDecodeError as err:
+        except (json.JSONDecodeError, UnicodeDecodeError) as err:
             raise ValueError(f"{path}:{number}: not a CBST data record ({err})") from err
     return records
 

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from arrange_up.evaluation.outcomes import FAILURE_KINDS, GOAL_MISSED, RolloutRecord
-from arrange_up.io.files import lock_exclusively
+from arrange_up.io.files import lock_exclusively, recorded_lines
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Pick, Place, Push
 
@@ -31,7 +31,6 @@ __all__ = [
     "RecordFileError",
     "plan_hash",
     "record_header",
-    "recorded_lines",
 ]
 
 RECORD_FORMAT = "arrange-up-rollouts/1"
@@ -39,46 +38,6 @@ RECORD_FORMAT = "arrange-up-rollouts/1"
 
 class RecordFileError(ValueError):
     """A record file that belongs to another evaluation, is corrupt, or is in use."""
-
-
-def recorded_lines(handle: IO[bytes], path: Path, record_format: str, what: str) -> list[bytes]:
-    """The complete lines of the ``.jsonl`` record open (read and append) in ``handle``, its
-    header first; a last line cut off by a run killed while writing it is dropped from the
-    file. An empty file, or one holding only the start of a cut-off header, is emptied and
-    ``[]`` returned. A file whose first line is not a header of ``record_format`` (``what``
-    names such a file in the message: "an arrange-up rollout record") raises
-    :class:`RecordFileError` *before anything is truncated*: it is someone else's file (a plan,
-    notes, another kind of record), and nothing of it may be lost. Shared by the rollout
-    records and the closed loop's episode records."""
-    handle.seek(0)
-    data = handle.read()
-    *complete, cut = data.split(b"\n")
-    refused = RecordFileError(
-        f"{path}:1: not {what} (its first line must be a {record_format!r} header); use "
-        "another record file"
-    )
-    if not any(line.strip() for line in complete):
-        if cut.strip() and not _cut_header(cut, record_format):
-            raise refused
-        handle.truncate(0)
-        return []
-    try:
-        found = json.loads(complete[0])
-    except ValueError:
-        found = None
-    if not isinstance(found, dict) or found.get("format") != record_format:
-        raise refused
-    if cut:
-        handle.truncate(len(data) - len(cut))
-    return complete
-
-
-def _cut_header(cut: bytes, record_format: str) -> bool:
-    """Whether ``cut`` can be the start of a header line of ``record_format`` cut off by a
-    killed write (its format key comes first, with or without spaces after the separators)."""
-    start = '{"format":"' + record_format + '"'
-    text = cut.decode("utf-8", errors="replace").replace(" ", "")
-    return start.startswith(text) or text.startswith(start)
 
 
 def plan_hash(actions: Sequence[Action]) -> str:
@@ -219,7 +178,7 @@ class RecordFile:
 
     def _read(self, header: dict) -> dict[int, RolloutRecord]:
         lines = recorded_lines(
-            self.handle, self.path, RECORD_FORMAT, "an arrange-up rollout record"
+            self.handle, self.path, RECORD_FORMAT, "an arrange-up rollout record", RecordFileError
         )
         if not lines:  # a new file, or one killed while writing its header: start afresh
             self.write_line(header)

@@ -28,13 +28,13 @@ from typing import Any
 
 from arrange_up.belief.states import AngleFrame
 from arrange_up.evaluation.outcomes import Failure, RolloutRecord
-from arrange_up.evaluation.records import RecordFileError, plan_hash, recorded_lines
+from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.evaluation.reliability import FailureBreakdown, Reliability
 from arrange_up.execution.belief import ModelFailure
 from arrange_up.execution.executor import SimulatedExecutor
 from arrange_up.execution.observations import Sensor
 from arrange_up.execution.replanning import ClosedLoop, ClosedLoopSettings, LoopOutcome, Replan
-from arrange_up.io.files import lock_exclusively
+from arrange_up.io.files import lock_exclusively, recorded_lines
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action
 
@@ -233,7 +233,9 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
         raise RecordFileError(f"{path}: the record file is in use by another run")
     try:
         # a last line cut off by a killed run is dropped (its episode runs again)
-        lines = recorded_lines(handle, path, EPISODES_FORMAT, "an arrange-up episode record")
+        lines = recorded_lines(
+            handle, path, EPISODES_FORMAT, "an arrange-up episode record", RecordFileError
+        )
         lines = [line for line in lines if line.strip()]
     except RecordFileError:
         handle.close()

@@ -1,8 +1,11 @@
 """Small file helpers shared by the readers and the resumable result files: where a file stops
-being UTF-8, and an exclusive lock that refuses a second writer."""
+being UTF-8, an exclusive lock that refuses a second writer, and the complete lines of a
+``.jsonl`` record (a line cut off by a kill dropped, a file of another kind refused)."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
 from typing import IO
 
 try:
@@ -10,7 +13,7 @@ try:
 except ImportError:  # pragma: no cover - not on POSIX: files are not locked
     fcntl = None
 
-__all__ = ["lock_exclusively", "undecodable_place"]
+__all__ = ["lock_exclusively", "recorded_lines", "undecodable_place"]
 
 
 def undecodable_place(data: bytes, error: UnicodeDecodeError) -> tuple[int, int]:
@@ -33,3 +36,49 @@ def lock_exclusively(handle: IO[bytes]) -> bool:
     except OSError:
         return False
     return True
+
+
+def recorded_lines(
+    handle: IO[bytes],
+    path: Path,
+    record_format: str,
+    what: str,
+    error: type[Exception] = ValueError,
+) -> list[bytes]:
+    """The complete lines of the ``.jsonl`` record open (read and append) in ``handle``, its
+    header first; a last line cut off by a run killed while writing it is dropped from the
+    file. An empty file, or one holding only the start of a cut-off header, is emptied and
+    ``[]`` returned. A file whose first line is not a header of ``record_format`` (``what``
+    names such a file in the message: "an arrange-up rollout record") raises
+    ``error`` (the caller's exception class) *before anything is truncated*: it is someone
+    else's file (a plan, notes, another kind of record), and nothing of it may be lost. Shared
+    by the rollout records, the closed loop's episode records and CBST's training data."""
+    handle.seek(0)
+    data = handle.read()
+    *complete, cut = data.split(b"\n")
+    refused = error(
+        f"{path}:1: not {what} (its first line must be a {record_format!r} header); use "
+        "another record file"
+    )
+    if not any(line.strip() for line in complete):
+        if cut.strip() and not _cut_header(cut, record_format):
+            raise refused
+        handle.truncate(0)
+        return []
+    try:
+        found = json.loads(complete[0])
+    except ValueError:
+        found = None
+    if not isinstance(found, dict) or found.get("format") != record_format:
+        raise refused
+    if cut:
+        handle.truncate(len(data) - len(cut))
+    return complete
+
+
+def _cut_header(cut: bytes, record_format: str) -> bool:
+    """Whether ``cut`` can be the start of a header line of ``record_format`` cut off by a
+    killed write (its format key comes first, with or without spaces after the separators)."""
+    start = '{"format":"' + record_format + '"'
+    text = cut.decode("utf-8", errors="replace").replace(" ", "")
+    return start.startswith(text) or text.startswith(start)

@@ -87,6 +87,12 @@ def test_generation_resumes_and_refuses_other_settings(tmp_path):
         generate_dataset(path, examples=5, rollouts=ROLLOUTS + 1, seed=4)
     with pytest.raises(ValueError, match="other parameters"):
         load_dataset(path, seed=5)
+    # A file of another kind is refused and left as it was, though it ends without a newline.
+    notes = tmp_path / "notes.jsonl"
+    notes.write_text('{"format": "arrange-up-plan/1"}')
+    with pytest.raises(ValueError, match="not a CBST data file"):
+        generate_dataset(notes, examples=1, rollouts=ROLLOUTS, seed=4)
+    assert notes.read_text() == '{"format": "arrange-up-plan/1"}'
 
 
 def test_wall_push_rules_draw_the_same_scenes_and_planner_pushes_do_not_buckle():
