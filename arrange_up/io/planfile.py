@@ -289,10 +289,15 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
         raise PlanFileError(
             f"{path}: format: expected {PLAN_FORMAT!r}, got {_shown(document.get('format'))}"
         )
-    if document.get("status") != "solved" or "actions" not in document:
+    if document.get("status") != "solved":
         raise PlanFileError(
             f"{path}: status: the plan is {_shown(document.get('status'))}, not "
             "'solved'; it holds no actions to use (expected a solved plan)"
+        )
+    if "actions" not in document:
+        raise PlanFileError(
+            f"{path}: actions: missing; a solved plan lists its actions (expected a list, "
+            "empty when the goal holds at the start)"
         )
     raw_units = document.get("units", {})
     if not isinstance(raw_units, dict):
