@@ -79,7 +79,8 @@ problem that is not an arrange-up one is refused with a status (``UNSUPPORTED_PR
 ``UNKNOWN`` from the validator) and a log message, a failure inside arrange-up is reported as
 ``INTERNAL_ERROR`` (``UNKNOWN``) with the exception named. Only the parameters are checked when
 the engine is made: a bad value raises ``ValueError``, an unknown name ``TypeError`` naming the
-accepted ones.
+accepted ones. A ``solve`` ``timeout`` that is not a positive number of seconds raises
+``ValueError`` too.
 
 **Kinds and guarantees.** ``supports(kind)`` is true for exactly the kind of the problems
 :func:`~arrange_up.up.compile.to_up` makes (:data:`SUPPORTED_KIND`), so selecting an engine by
@@ -444,6 +445,7 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
         output_stream: IO[str] | None = None,
     ) -> PlanGenerationResult:
         started = time.monotonic()
+        _check_timeout(ENGINE_NAME, timeout)
         if heuristic is not None:
             warnings.warn(
                 "arrange-up ignores the heuristic argument: it searches belief space with its "
@@ -560,8 +562,7 @@ def _check_params(
         )
     if not _positive(particles):
         raise ValueError(f"arrange-up: particles must be a positive integer, got {particles!r}")
-    if not isinstance(seed, int) or isinstance(seed, bool):
-        raise ValueError(f"arrange-up: seed must be an integer, got {seed!r}")
+    _check_seed(ENGINE_NAME, seed)
     if max_nodes is not None and not _positive(max_nodes):
         raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
     try:
@@ -651,6 +652,13 @@ def _read_problem_and_plan(
     except Exception as error:  # plan_from_up refuses foreign plans with ValueError
         return _Refusal(f"reading the plan failed: {type(error).__name__}: {error}", True)
     return arrangement, actions
+
+
+def _check_seed(engine: str, seed: Any) -> None:
+    """The engines' ``seed`` parameter: a non-negative integer (as the command line's
+    ``--seed``; numpy's seed sequences refuse negative ones, so the check is made up front)."""
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ValueError(f"{engine}: seed must be a non-negative integer, got {seed!r}")
 
 
 def _check_timeout(engine: str, timeout: Any) -> None:
@@ -833,8 +841,7 @@ def _check_validator_params(
 ) -> None:
     if not _positive(rollouts):
         raise ValueError(f"{VALIDATOR_NAME}: rollouts must be a positive integer, got {rollouts!r}")
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise ValueError(f"{VALIDATOR_NAME}: seed must be a non-negative integer, got {seed!r}")
+    _check_seed(VALIDATOR_NAME, seed)
     _check_parallel_params(VALIDATOR_NAME, workers, backend, scheduler)
 
 
@@ -1004,8 +1011,7 @@ def _check_repairer_params(particles: Any, seed: Any, method: Any, workers: Any)
         raise ValueError(
             f"{REPAIRER_NAME}: particles must be a positive integer, got {particles!r}"
         )
-    if not isinstance(seed, int) or isinstance(seed, bool):
-        raise ValueError(f"{REPAIRER_NAME}: seed must be an integer, got {seed!r}")
+    _check_seed(REPAIRER_NAME, seed)
     if method not in METHODS:
         expected = " or ".join(repr(m) for m in METHODS)
         raise ValueError(f"{REPAIRER_NAME}: method must be {expected}, got {method!r}")

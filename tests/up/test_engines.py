@@ -116,6 +116,23 @@ def test_parameters_are_checked():
         OneshotPlanner(name="arrange-up", params={"validate": -1})
     with pytest.raises(ValueError, match="validate checks particle plans"):
         OneshotPlanner(name="arrange-up", params={"semantics": "cbst", "validate": 4})
+    # a negative seed, for every engine and semantics, when the engine is made
+    for make, engine in (
+        (OneshotPlanner, "arrange-up"),
+        (PlanValidator, "arrange-up-reliability"),
+        (PlanRepairer, "arrange-up-fixtures"),
+    ):
+        with pytest.raises(ValueError, match=f"{engine}: seed must be a non-negative integer"):
+            make(name=engine, params={"seed": -1})
+    with pytest.raises(ValueError, match="arrange-up: seed must be a non-negative integer"):
+        OneshotPlanner(name="arrange-up", params={"semantics": "deterministic", "seed": -1})
+
+
+def test_a_solve_timeout_that_is_not_a_positive_number_is_refused():
+    problem = to_up(load("blocks-1"))
+    for timeout in (-1, 0, float("nan"), "abc", True):
+        with pytest.raises(ValueError, match="arrange-up: timeout must be a positive number"):
+            _solve(problem, timeout=timeout)
 
 
 def test_a_particle_plan_reports_its_validation():
