@@ -198,9 +198,28 @@ class _Text:
         before = self.text[:index]
         return before.count("\n") + 1, index - (before.rfind("\n") + 1) + 1
 
+    def token_at(self, line: int, column: int | None, pattern: str = r"[^\s()]+") -> str | None:
+        """What ``pattern`` (by default a name or a number) matches at ``line``, ``column``
+        (1-based), as the file spells it; None when it matches nothing there."""
+        lines = self.text.splitlines()
+        if not 1 <= line <= len(lines) or column is None:
+            return None
+        match = re.match(pattern, lines[line - 1][column - 1 :])
+        return match.group(0) if match else None
+
     def find(self, pattern: str) -> tuple[int | None, int | None]:
         match = re.search(pattern, self.code, flags=re.IGNORECASE)
         return self.position(match.start()) if match else (None, None)
+
+    def declared_again(self, name: str) -> tuple[int | None, int | None]:
+        """Where ``:objects`` declares ``name`` (whatever its case) a second time, or, declared
+        once (named like a type of the domain), where it does so."""
+        section = re.search(r"\(\s*:objects\b[^)]*\)", self.code, flags=re.IGNORECASE)
+        if section is None:
+            return None, None
+        pattern = rf"(?<![\w-]){re.escape(name)}(?![\w-])"
+        found = list(re.finditer(pattern, section.group(0), flags=re.IGNORECASE))[:2]
+        return self.position(section.start() + found[-1].start()) if found else (None, None)
 
     def domain_name(self) -> str | None:
         match = re.search(r"\(\s*:domain\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
@@ -282,8 +301,44 @@ def _reader_diagnostic(error: Exception, source: str, located: _Text) -> Diagnos
         found = re.search(r"line:?\s*(\d+),\s*col:?\s*(\d+)", message)
         if found:
             line, column = int(found.group(1)), int(found.group(2))
-        message = f"unified-planning's PDDL reader refused the problem: {message}"
+        line, column, message = _explained(message, line, column, located)
     return Diagnostic(source, line, column, "", message)
+
+
+def _explained(
+    message: str, line: int | None, column: int | None, located: _Text
+) -> tuple[int | None, int | None, str]:
+    """unified-planning's reader ``message`` (at ``line``, ``column`` when it gives them) as
+    this format's words: what was found, in the file's own spelling, and what was expected;
+    ``(line, column, message)``, the message its own when it is none of those known."""
+    expression = re.match(r"Found invalid expression: (.*?)\. From line", message)
+    handled = re.match(r"Not able to handle: (.*?) found at line", message)
+    twice = re.match(r"Name (\S+) already defined!", message)
+    if expression and line is not None:
+        written = located.token_at(line, column) or expression.group(1)
+        said = (
+            f"unknown name or value {written!r}: expected a number, or an object declared "
+            "under :objects"
+        )
+    elif handled and line is not None:
+        written = located.token_at(line, column, r"\([^()]*\)") or handled.group(1)
+        said = (
+            f"cannot read {written!r}: expected a function of the {DOMAIN_NAME} domain "
+            f"({DOMAIN_FILE}) applied to declared objects"
+        )
+    elif message.startswith("Missing goal section"):
+        line, column = located.find(r"\(\s*define")
+        said = "missing (:goal ...): expected a goal section in the problem"
+    elif twice:
+        name = twice.group(1)
+        line, column = located.declared_again(name)
+        said = (
+            f"the name {name!r} is defined twice (PDDL names ignore case, and an object may "
+            "not be named like a type of the domain): expected names unique regardless of case"
+        )
+    else:
+        said = f"unified-planning's PDDL reader refused the problem: {message}"
+    return line, column, said
 
 
 @dataclass

@@ -334,6 +334,52 @@ def test_a_non_numeric_initial_value_is_refused_with_its_place():
     assert "b1.pddl:" in message and "expected a number" in message
 
 
+def _edited_blocks_1(old: str, new: str) -> str:
+    text = (domains_dir() / "blocks-1.pddl").read_text()
+    assert old in text
+    return text.replace(old, new)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        # a name nothing declares, in the file's spelling (the reader lower-cases it)
+        (
+            "(on-table A)",
+            "(on-table Cube)",
+            "unknown name or value 'Cube': expected a number, or an object declared under :objects",
+        ),
+        ("(= (table-width) 10)", "(= (table-width) ten)", "unknown name or value 'ten'"),
+        (
+            "(on-table A)",
+            "(on-table A) (> (mass A) 1)",
+            "cannot read '(mass A)': expected a function of the arrange-up domain",
+        ),
+        ("A - ", "A a - ", "the name 'a' is defined twice (PDDL names ignore case"),
+    ],
+    ids=["unknown object", "word for a number", "unknown function", "names differing in case"],
+)
+def test_what_unified_plannings_reader_refuses_is_said_in_the_files_words(old, new, expected):
+    text = _edited_blocks_1(old, new)
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "b1.pddl")
+    [diagnostic] = caught.value.diagnostics
+    assert expected in diagnostic.message and "unified-planning" not in diagnostic.message
+    assert diagnostic.line is not None and diagnostic.column is not None
+    written = text.splitlines()[diagnostic.line - 1][diagnostic.column - 1 :]
+    assert written.lower().startswith(expected.split("'")[1].lower())
+
+
+def test_a_problem_without_a_goal_is_refused_at_its_define():
+    text = (domains_dir() / "blocks-1.pddl").read_text()
+    goal = text.index("(:goal")
+    text = text[:goal] + ")\n"  # the goal section and what follows cut off
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(text, "b1.pddl")
+    [diagnostic] = caught.value.diagnostics
+    assert "missing (:goal ...)" in diagnostic.message and diagnostic.line is not None
+
+
 # -- what unified-planning's PDDLWriter writes ---------------------------------------------
 @pytest.mark.parametrize("name", SHIPPED_PDDL)
 def test_pddl_written_by_unified_planning_is_read(name, tmp_path: Path):
