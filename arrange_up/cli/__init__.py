@@ -133,5 +133,5 @@ def main() -> None:
       arrange-up check my-problem.yaml        validate problem files
       arrange-up bench physics                measure simulated pushes per second
 
-    PROBLEM arguments take a path to a .yaml file or a shipped domain's name.
+    PROBLEM arguments take a path to a .yaml or .pddl file or a shipped domain's name.
     """

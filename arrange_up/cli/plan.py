@@ -79,7 +79,8 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     type=click.IntRange(1, 100_000),
     default=library_default(run_plan, "particles"),
     show_default=True,
-    help="Particles per belief (particle semantics).",
+    help="Particles per belief (particle semantics; deterministic plans from one, CBST from "
+    "intervals).",
 )
 @seed_option("Seed for initial particles and noise: equal seeds give equal plans.")
 @click.option(

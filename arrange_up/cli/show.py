@@ -37,13 +37,15 @@ from arrange_up.transitions import available
     "-o",
     type=OutputFile(FIGURE_SUFFIXES),
     default=None,
-    help="Where to write the picture (.png, .svg or .pdf); with --plan, the storyboard.",
+    help="Where to write the picture (.png, .svg or .pdf); with --plan, the storyboard. "
+    "Required unless --plan is given with --animate.",
 )
 @click.option(
     "--dpi",
     type=click.IntRange(30, 600),
     default=library_default(draw_problem, "dpi"),
     show_default=True,
+    help="Resolution of a .png picture, in dots per inch.",
 )
 @click.option(
     "--plan",
