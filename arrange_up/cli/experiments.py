@@ -173,10 +173,23 @@ def _fixture_line(row: dict[str, Any]) -> str:
     return line
 
 
-def _refuse_bad_problems(names: list[str]) -> None:
-    """Exit 2 on the first problem that does not load, before hours of work."""
+def _problem_names(problems: str) -> list[str]:
+    """The comma-separated ``--problems``; exit 2 when there is none, or on the first that
+    does not load, before hours of work."""
+    names = [n.strip() for n in problems.split(",") if n.strip()]
+    if not names:
+        fail("--problems: expected at least one problem")
     for name in names:
         load_problem(name)
+    return names
+
+
+def _interrupted(csv: Path) -> None:
+    """Exit 1 after Ctrl-C, saying where the rows measured so far are."""
+    fail(f"interrupted; the rows measured so far are in {csv}: run again to resume", EXIT_NEGATIVE)
+
+
+_OUTPUT_HELP = "Where {csv} and its picture go; a {csv} already there is resumed."
 
 
 @experiment.command("transition-comparison")
@@ -218,6 +231,7 @@ def _refuse_bad_problems(names: list[str]) -> None:
     type=click.IntRange(1, None),
     default=library_default(transition_comparison, "max_nodes"),
     show_default=True,
+    help="Node limit of each planning run.",
 )
 @timeout_option("Planning time limit per run, seconds.")
 @click.option(
@@ -227,7 +241,13 @@ def _refuse_bad_problems(names: list[str]) -> None:
     help="Worker processes (default: all cores).",
 )
 @_controller_option
-@click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
+@click.option(
+    "--output-dir",
+    type=OutputDir(),
+    default="results",
+    show_default=True,
+    help=_OUTPUT_HELP.format(csv="transition-comparison.csv"),
+)
 def experiment_transition_comparison(
     problems: str,
     particle_counts: str,
@@ -240,15 +260,35 @@ def experiment_transition_comparison(
     controller: str | None,
     output_dir: str,
 ) -> None:
-    """Figures 3-6 and 3-7: planning time and reliability of each belief transition."""
+    """Figures 3-6 and 3-7: planning time and reliability of each belief transition.
+
+    For each problem and planner (the particle planners of --particles, and the other
+    semantics), --runs planning runs with seeds 0..R-1, each plan evaluated over --rollouts
+    noisy rollouts.
+
+    \b
+    Writes into --output-dir:
+      transition-comparison.csv   one row per planning run (and its evaluation)
+      transition-comparison.png   planning time and reliability per planner
+    and prints a Markdown table on stdout; progress lines go to stderr. Rows are written as
+    they are measured, and rerunning resumes (grow --runs or --problems later); a CSV measured
+    with other settings (--rollouts, --max-nodes, --timeout, --controller) is refused.
+
+    \b
+    Example:
+      arrange-up experiment transition-comparison --problems blocks-1,blocks-2 \\
+          --particles 5 --runs 2 --rollouts 100 --output-dir tc
+
+    Exit status: 0 the runs were made (whatever they found), 1 interrupted, 2 bad input or a
+    CSV of other settings.
+    """
     counts = comma_integers("--particles", particle_counts)
     planners = [p for p in default_planners(counts) if p.semantics in _PARTICLE_PLANNERS]
     names = extra.split(",") if extra else [n for n in available() if n not in _PARTICLE_PLANNERS]
     for name in names:
         check_semantics(name)
         planners.append(Planner(name, name, 1))
-    names = [n.strip() for n in problems.split(",") if n.strip()]
-    _refuse_bad_problems(names)
+    names = _problem_names(problems)
     pending = pending_transition_runs(Path(output_dir), names, planners, runs)
     estimate = costs.Estimate()
     for name, label, _run in pending:
@@ -273,6 +313,8 @@ def experiment_transition_comparison(
                 progress=report.say,
                 measured=lambda row: report.done(_transition_line(row)),
             )
+    except KeyboardInterrupt:
+        _interrupted(Path(output_dir) / "transition-comparison.csv")
     except CsvRecordsError as error:
         fail(str(error))
     rows = select_transition_rows(read_csv(path), names, [p.label for p in planners], runs)
@@ -297,23 +339,32 @@ def experiment_transition_comparison(
     type=click.IntRange(1, 100_000),
     default=library_default(search_table, "particles"),
     show_default=True,
+    help="Particles per belief, for the particles semantics.",
 )
 @click.option(
     "--max-nodes",
     type=click.IntRange(1, None),
     default=library_default(search_table, "max_nodes"),
     show_default=True,
+    help="Node limit of each search.",
 )
 @click.option(
     "--weight",
     type=FiniteFloat(0, None),
     default=library_default(search_table, "weight"),
     show_default=True,
-    help="1 = A*, as in the thesis's table.",
+    help="f = g + weight * h: 1 = A*, as in the thesis's table; more is greedier; 0 ignores "
+    "the heuristic (uniform-cost search).",
 )
 @timeout_option("Time limit per search, seconds.")
 @_controller_option
-@click.option("--output-dir", type=OutputDir(), default="results", show_default=True)
+@click.option(
+    "--output-dir",
+    type=OutputDir(),
+    default="results",
+    show_default=True,
+    help=_OUTPUT_HELP.format(csv="search-table.csv"),
+)
 def experiment_search_table(
     problems: str,
     semantics: str | None,
@@ -325,12 +376,28 @@ def experiment_search_table(
     output_dir: str,
 ) -> None:
     """Table 3.1: nodes expanded and plan cost for each heuristic, with and without
-    domination."""
+    domination.
+
+    \b
+    Writes into --output-dir:
+      search-table.csv              one row per search
+      search-table-SEMANTICS.png    nodes expanded per search type
+    and prints a Markdown table on stdout; progress lines go to stderr. Rows are written as
+    they are measured, and rerunning resumes; a CSV measured with other settings
+    (--particles, --max-nodes, --weight, --timeout, --controller) is refused.
+
+    \b
+    Example:
+      arrange-up experiment search-table --problems blocks-1,blocks-2 \\
+          --semantics deterministic --output-dir st
+
+    Exit status: 0 the searches ran (whatever they found), 1 interrupted, 2 bad input or a CSV
+    of other settings.
+    """
     if semantics is None:
         semantics = "cbst" if "cbst" in available() else "deterministic"
     check_semantics(semantics)
-    names = [n.strip() for n in problems.split(",") if n.strip()]
-    _refuse_bad_problems(names)
+    names = _problem_names(problems)
     pending = pending_searches(Path(output_dir), names, semantics)
     estimate = costs.Estimate()
     for k, domination, name in pending:
@@ -354,6 +421,8 @@ def experiment_search_table(
                 progress=report.say,
                 measured=lambda row: report.done(_search_line(row)),
             )
+    except KeyboardInterrupt:
+        _interrupted(Path(output_dir) / "search-table.csv")
     except CsvRecordsError as error:
         fail(str(error))
     click.echo(search_markdown(select_search_rows(read_csv(path), names, semantics)))
@@ -458,8 +527,9 @@ def experiment_fixtures(
     reason (and no evaluation).
 
     Rows are written as they are measured, and rerunning resumes: rows already in the CSV
-    (same problem, seed, plan, particles, method) are not measured again, whatever
-    --rollouts. So you can interrupt a run, or grow --plans and --particles later.
+    (same problem, seed, plan, particles, method) are not measured again, so you can
+    interrupt a run, or grow --plans and --particles later. A CSV measured with other
+    --rollouts, --timeout or --controller is refused rather than mixed.
 
     \b
     Examples:
@@ -477,10 +547,7 @@ def experiment_fixtures(
     counts = comma_integers("--particles", particle_counts)
     if not counts or any(n < 1 for n in counts):
         fail(f"--particles: expected positive integers, got {particle_counts!r}")
-    names = [n.strip() for n in problems.split(",") if n.strip()]
-    if not names:
-        fail("--problems: expected at least one problem")
-    _refuse_bad_problems(names)
+    names = _problem_names(problems)
     pending = pending_rows(
         Path(output_dir),
         problems=names,
@@ -513,11 +580,7 @@ def experiment_fixtures(
                 measured=lambda row: report.done(_fixture_line(row)),
             )
     except KeyboardInterrupt:
-        fail(
-            f"interrupted; the rows measured so far are in {Path(output_dir) / CSV_NAME}: "
-            "run again to resume",
-            EXIT_NEGATIVE,
-        )
+        _interrupted(Path(output_dir) / CSV_NAME)
     except (StaleResultsError, BackendUnavailableError, ValueError) as error:
         fail(str(error))
     rows = select_rows(

@@ -174,6 +174,18 @@ def test_the_command_estimates_reports_each_run_and_prints_the_table(tmp_path, m
     assert out[-1].startswith("wrote ")
 
 
+@pytest.mark.parametrize("command", ["transition-comparison", "search-table", "fixtures"])
+def test_an_experiment_without_problems_is_refused(command, tmp_path):
+    for problems in ("", ","):
+        result = CliRunner().invoke(
+            main, ["experiment", command, "--problems", problems, "--output-dir", str(tmp_path)]
+        )
+        assert result.exit_code == 2 and "--problems: expected at least one problem" in (
+            result.output
+        )
+    assert not any(tmp_path.iterdir())  # nothing written
+
+
 class Terminal(io.StringIO):
     def isatty(self) -> bool:
         return True
