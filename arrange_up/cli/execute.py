@@ -163,6 +163,11 @@ def execute(
     interrupted, 2 bad input.
     """
     check_semantics(semantics)
+    if storyboard is not None and storyboard_episode >= episodes:
+        fail(
+            f"--storyboard-episode {storyboard_episode}: expected one of the episodes run, "
+            f"0 to {episodes - 1} (--episodes {episodes})"
+        )
     loaded = load_problem(problem)
     if plan_file is not None:
         actions, _ = read_plan_file(loaded, plan_file, warn_mismatch=True)
@@ -182,7 +187,10 @@ def execute(
         landing=landing,
     )
 
+    finished: list[EpisodeRecord] = []
+
     def report(episode: EpisodeRecord) -> None:
+        finished.append(episode)
         if not as_json:
             outcome = "ok" if episode.success else str(episode.failure.kind)  # type: ignore[union-attr]
             click.echo(
@@ -204,8 +212,16 @@ def execute(
             progress=report,
         )
     except KeyboardInterrupt:
-        kept = f"; the finished episodes are in {record}: run again to resume" if record else ""
-        fail(f"interrupted{kept}", EXIT_NEGATIVE)
+        if record:
+            kept = f"the finished episodes are in {record}: run again to resume"
+        else:
+            kept = "they are not kept: --record FILE keeps every finished episode to resume"
+        reached = sum(e.success for e in finished)
+        fail(
+            f"interrupted after {len(finished)} of {episodes} episodes ({reached} reached the "
+            f"goal; no result is given for part of a run); {kept}",
+            EXIT_NEGATIVE,
+        )
     except (RecordFileError, ValueError) as error:
         fail(str(error))
     if storyboard is not None:

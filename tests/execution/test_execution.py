@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+import arrange_up.cli.execute as execute_command
 from arrange_up.belief.states import IntervalBelief, ObjectInterval, ParticleBelief
 from arrange_up.cli import main
 from arrange_up.execution import (
@@ -238,6 +239,27 @@ def test_the_execute_command_reports_rate_replans_and_failures(blocks2, tmp_path
     assert bad.exit_code == 2 and "sonar" in bad.output
     unknown = runner.invoke(main, ["execute", "blocks-2", "--semantics", "magic"])
     assert unknown.exit_code == 2 and "unknown semantics" in unknown.output
+    beyond = runner.invoke(
+        main,
+        ["execute", "blocks-2", "--episodes", "2", "--storyboard", str(tmp_path / "s.png"),
+         "--storyboard-episode", "5"],
+    )  # fmt: skip
+    assert beyond.exit_code == 2 and "expected one of the episodes run, 0 to 1" in beyond.output
+    assert not (tmp_path / "s.png").exists()
+
+
+def test_an_interrupted_execute_says_how_far_it_got_and_what_is_kept(blocks2, monkeypatch):
+    def two_then_ctrl_c(*args, progress, **kwargs):
+        for record in (EpisodeRecord(0, True, None, 3, (), (), "done"),) * 2:
+            progress(record)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(execute_command, "run_episodes", two_then_ctrl_c)
+    args = ["execute", "blocks-2", "--episodes", "5", "--semantics", "deterministic"]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 1
+    assert "interrupted after 2 of 5 episodes (2 reached the goal" in result.output
+    assert "--record FILE keeps every finished episode" in result.output
 
 
 def test_the_fake_robot_example_runs_the_loop(capsys):
