@@ -640,8 +640,9 @@ def _score_card(cv_scores: Mapping[str, Any], test_scores: Mapping[str, Any]) ->
 def _fresh_seed(seed: int, test_seed: int) -> None:
     if test_seed == seed:
         raise ValueError(
-            f"the test set must be generated with another seed than the training data "
-            f"(both {seed}): a fresh test set"
+            "the test set must be generated with another seed than the training data "
+            f"(both {seed}): give test_seed (--test-seed) another value than seed (--seed), "
+            "so that the test set is fresh"
         )
 
 

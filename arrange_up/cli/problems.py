@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import click
@@ -69,7 +70,8 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
         other = names.get(key)
         if other is not None and other.stem != path.stem:
             click.echo(
-                f"{shown}: error: name: problem name {problem.name!r} is already used by "
+                f"{shown}{_name_place(path)}: error: name: problem name {problem.name!r} is "
+                "already used by "
                 f"{other} in the same folder; names must be unique within a folder (a "
                 "problem's YAML and PDDL twins share a file name)",
                 err=True,
@@ -118,3 +120,15 @@ def export(problem: str, fmt: str, output: str) -> None:
         fail(str(error), EXIT_NEGATIVE)
     write_text_atomic(Path(output), text)
     click.echo(f"wrote {output}")
+
+
+def _name_place(path: Path) -> str:
+    """``:LINE:COLUMN`` of the problem's name in the file (a YAML file's top-level ``name:``
+    value, a PDDL file's ``(problem NAME)``), or "" when it is not found."""
+    text = path.read_text(encoding="utf-8", errors="replace")
+    pattern = r"\(\s*problem\s+" if path.suffix.lower() == ".pddl" else r"(?m)^name[ \t]*:[ \t]*"
+    match = re.search(pattern, text, flags=re.IGNORECASE)
+    if match is None:
+        return ""
+    before = text[: match.end()]
+    return f":{before.count(chr(10)) + 1}:{match.end() - (before.rfind(chr(10)) + 1) + 1}"

@@ -122,6 +122,9 @@ def test_check_still_refuses_two_problems_of_one_name_in_a_folder(tmp_path):
     result = run("check", str(tmp_path / "one.yaml"), str(tmp_path / "two.yaml"))
     assert result.exit_code == 1
     assert "problem name 'blocks-1' is already used by" in result.output
+    # at the name's place, as every diagnostic of check is
+    line = next(n for n, t in enumerate(text.splitlines(), 1) if t.startswith("name:"))
+    assert f"two.yaml:{line}:7: error: name: problem name" in result.output
 
 
 def test_check_reports_a_folder_or_a_missing_file_and_checks_the_rest(tmp_path):
