@@ -25,13 +25,7 @@ from arrange_up.io.files import lock_exclusively, recorded_lines
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Pick, Place, Push
 
-__all__ = [
-    "RECORD_FORMAT",
-    "RecordFile",
-    "RecordFileError",
-    "plan_hash",
-    "record_header",
-]
+__all__ = ["RECORD_FORMAT", "RecordFile", "RecordFileError", "plan_hash", "record_header"]
 
 RECORD_FORMAT = "arrange-up-rollouts/1"
 
