@@ -33,7 +33,6 @@ from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episod
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import (
-    plan_document,
     plan_problem_mismatch,
     read_plan,
     write_json_atomic,
@@ -187,19 +186,7 @@ def first_plan(problem, args, path: Path) -> tuple | None:
         print(f"{problem.name}: no first plan ({first.reason})", flush=True)
         return None
     actions = first.actions or ()
-    document = plan_document(
-        problem,
-        actions,
-        status=first.status,
-        semantics=first.semantics,
-        seed=args.seed,
-        search=first.stats,
-        extra={
-            "particles": first.particles,
-            **({"validation": first.validation.to_json()} if first.validation else {}),
-        },
-    )
-    write_json_atomic(path, document)
+    write_json_atomic(path, first.document(problem))
     return actions
 
 

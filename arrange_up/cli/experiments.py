@@ -189,7 +189,15 @@ def _interrupted(csv: Path) -> None:
     fail(f"interrupted; the rows measured so far are in {csv}: run again to resume", EXIT_NEGATIVE)
 
 
-_OUTPUT_HELP = "Where {csv} and its picture go; a {csv} already there is resumed."
+def _output_dir_option(csv: str) -> Any:
+    """``--output-dir`` of an experiment that writes ``csv`` and its picture there."""
+    return click.option(
+        "--output-dir",
+        type=OutputDir(),
+        default="results",
+        show_default=True,
+        help=f"Where {csv} and its picture go; a {csv} already there is resumed.",
+    )
 
 
 @experiment.command("transition-comparison")
@@ -241,13 +249,7 @@ _OUTPUT_HELP = "Where {csv} and its picture go; a {csv} already there is resumed
     help="Worker processes (default: all cores).",
 )
 @_controller_option
-@click.option(
-    "--output-dir",
-    type=OutputDir(),
-    default="results",
-    show_default=True,
-    help=_OUTPUT_HELP.format(csv="transition-comparison.csv"),
-)
+@_output_dir_option("transition-comparison.csv")
 def experiment_transition_comparison(
     problems: str,
     particle_counts: str,
@@ -358,13 +360,7 @@ def experiment_transition_comparison(
 )
 @timeout_option("Time limit per search, seconds.")
 @_controller_option
-@click.option(
-    "--output-dir",
-    type=OutputDir(),
-    default="results",
-    show_default=True,
-    help=_OUTPUT_HELP.format(csv="search-table.csv"),
-)
+@_output_dir_option("search-table.csv")
 def experiment_search_table(
     problems: str,
     semantics: str | None,

@@ -27,7 +27,7 @@ from arrange_up.cli.shared import (
     terminal_progress,
     timeout_option,
 )
-from arrange_up.io.planfile import plan_document, write_json_atomic
+from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.parallel import BackendUnavailableError, available_cores
 from arrange_up.planning.heuristics import HEURISTICS
@@ -217,19 +217,7 @@ def plan(
         fail(f"--model {model}: {error}")
     except KeyboardInterrupt:
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
-    document = plan_document(
-        loaded,
-        result.actions,
-        status=result.status,
-        semantics=result.semantics,
-        seed=seed,
-        search=result.stats,
-        extra={
-            "particles": result.particles,
-            **({"model": model} if model else {}),
-            **({"validation": result.validation.to_json()} if result.validation else {}),
-        },
-    )
+    document = result.document(loaded, model)
     if output:
         write_json_atomic(Path(output), document)
     if as_json:

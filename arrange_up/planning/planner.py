@@ -23,6 +23,7 @@ import numpy as np
 from arrange_up.belief.goals import PartMiss
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.geometry.shapes import footprint
+from arrange_up.io.planfile import plan_document
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
 from arrange_up.parallel import Runner, SerialRunner, check_runner_options, get_runner
@@ -202,6 +203,24 @@ class PlanResult:
                 "part's shadow must keep clear of the walls, obstacles and parts on the table)"
             )
         return line
+
+    def document(self, problem: ArrangementProblem, model: str | None = None) -> dict[str, Any]:
+        """The plan file of this result for ``problem`` (docs/plan-format.md): its actions when
+        solved, the search statistics, the particles, the validation when it was validated,
+        and the ``model`` a CBST search used when given."""
+        return plan_document(
+            problem,
+            self.actions,
+            status=self.status,
+            semantics=self.semantics,
+            seed=self.seed,
+            search=self.stats,
+            extra={
+                "particles": self.particles,
+                **({"model": model} if model else {}),
+                **({"validation": self.validation.to_json()} if self.validation else {}),
+            },
+        )
 
     @property
     def stats(self) -> dict[str, Any]:
