@@ -133,6 +133,9 @@ def show(
     loaded = load_problem(problem)
     if heatmap_step is not None and plan_file is None:
         fail("--heatmap needs --plan")
+    given = click.get_current_context().get_parameter_source("rollouts")
+    if plan_file is None and given is click.core.ParameterSource.COMMANDLINE:
+        fail("--rollouts needs --plan: the rollouts are drawn on a plan's storyboard")
     if animation_file is not None:
         if plan_file is None:
             fail("--animate needs --plan")

@@ -51,6 +51,11 @@ def test_show_animate_refusals_exit_2_naming_the_problem(tmp_path, monkeypatch):
     plan, _ = plan_file(tmp_path)
     result = run("show", "blocks-1", "--animate", str(tmp_path / "a.gif"))
     assert result.exit_code == 2 and "--animate needs --plan" in result.stderr
+    # rollouts are drawn on a plan: without one, asking for them is refused, not ignored
+    result = run("show", "blocks-1", "--rollouts", "20", "-o", str(tmp_path / "p.png"))
+    assert result.exit_code == 2 and "--rollouts needs --plan" in result.stderr
+    assert not (tmp_path / "p.png").exists()
+    assert run("show", "blocks-1", "-o", str(tmp_path / "p.png")).exit_code == 0
     result = run("show", "blocks-1", "--plan", str(plan), "--animate", str(tmp_path / "a.avi"))
     assert result.exit_code == 2 and "unknown animation format '.avi'" in result.stderr
     monkeypatch.setattr(mpl_animation.writers, "is_available", lambda name: name != "ffmpeg")
