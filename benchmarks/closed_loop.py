@@ -32,11 +32,7 @@ from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.io.domains import load
-from arrange_up.io.planfile import (
-    plan_problem_mismatch,
-    read_plan,
-    write_json_atomic,
-)
+from arrange_up.io.planfile import plan_problem_mismatch, read_plan, write_json_atomic
 from arrange_up.model.problem import driven_by
 from arrange_up.planning.planner import plan
 

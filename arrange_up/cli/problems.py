@@ -14,6 +14,7 @@ from arrange_up.io.domains import (
     list_domains,
     resolve_problem,
 )
+from arrange_up.io.files import text_place
 from arrange_up.io.pddl import PddlExportError, write_pddl_problem
 from arrange_up.io.planfile import write_text_atomic
 
@@ -130,5 +131,5 @@ def _name_place(path: Path) -> str:
     match = re.search(pattern, text, flags=re.IGNORECASE)
     if match is None:
         return ""
-    before = text[: match.end()]
-    return f":{before.count(chr(10)) + 1}:{match.end() - (before.rfind(chr(10)) + 1) + 1}"
+    line, column = text_place(text, match.end())
+    return f":{line}:{column}"

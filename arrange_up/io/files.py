@@ -13,16 +13,21 @@ try:
 except ImportError:  # pragma: no cover - not on POSIX: files are not locked
     fcntl = None
 
-__all__ = ["lock_exclusively", "recorded_lines", "undecodable_place"]
+__all__ = ["lock_exclusively", "recorded_lines", "text_place", "undecodable_place"]
+
+
+def text_place(text: str | bytes, index: int) -> tuple[int, int]:
+    """The 1-based ``(line, column)`` of position ``index`` in ``text`` (characters of a
+    string, bytes of bytes)."""
+    newline = b"\n" if isinstance(text, bytes) else "\n"
+    before = text[:index]
+    return before.count(newline) + 1, len(before) - (before.rfind(newline) + 1) + 1
 
 
 def undecodable_place(data: bytes, error: UnicodeDecodeError) -> tuple[int, int]:
     """The 1-based ``(line, column)`` in ``data`` of the byte ``error`` (from decoding ``data``)
     says is not UTF-8."""
-    before = data[: error.start]
-    line = before.count(b"\n") + 1
-    column = len(before) - (before.rfind(b"\n") + 1) + 1
-    return line, column
+    return text_place(data, error.start)
 
 
 def lock_exclusively(handle: IO[bytes]) -> bool:

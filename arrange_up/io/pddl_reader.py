@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.io import validation
-from arrange_up.io.files import undecodable_place
+from arrange_up.io.files import text_place, undecodable_place
 from arrange_up.io.pddl_domain import (
     ANGLE_FUNCTIONS,
     DOMAIN_FILE,
@@ -195,8 +195,7 @@ class _Text:
         self.code = re.sub(r";[^\n]*", lambda m: " " * len(m.group(0)), text)
 
     def position(self, index: int) -> tuple[int, int]:
-        before = self.text[:index]
-        return before.count("\n") + 1, index - (before.rfind("\n") + 1) + 1
+        return text_place(self.text, index)
 
     def token_at(self, line: int, column: int | None, pattern: str = r"[^\s()]+") -> str | None:
         """What ``pattern`` (by default a name or a number) matches at ``line``, ``column``

@@ -25,7 +25,7 @@ from ruamel.yaml.reader import ReaderError
 from ruamel.yaml.scalarbool import ScalarBoolean
 
 from arrange_up.io import yaml_tree
-from arrange_up.io.files import undecodable_place
+from arrange_up.io.files import text_place, undecodable_place
 from arrange_up.io.validation import angle_problem
 from arrange_up.io.yaml_tree import YamlMap, join
 from arrange_up.model.errors import Diagnostic
@@ -97,8 +97,7 @@ def parse(text: str, report: Report) -> YamlMap | None:
         report.error((line, column), "", f"not valid YAML: {what}")
         return None
     except ReaderError as error:  # a character YAML does not allow, such as NUL
-        before = text[: error.position]
-        line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+        line, column = text_place(text, error.position)
         report.error(
             (line, column),
             "",
@@ -165,8 +164,7 @@ def long_number(text: str) -> tuple[int | None, int | None, int]:
     match = re.search(rf"\d{{{limit + 1},}}", text) if limit else None
     if match is None:
         return None, None, 0
-    before = text[: match.start()]
-    line, column = before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+    line, column = text_place(text, match.start())
     return line, column, len(match.group(0))
 
 
