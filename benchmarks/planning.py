@@ -159,13 +159,37 @@ def run(code_root: Path, case: tuple[str, str], config: str, seed: int) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", default="blocks-7:25,blocks-4:50")
-    parser.add_argument("--configs", default="local:1,local:2")
-    parser.add_argument("--baseline", default=None, metavar="GITREF")
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--output", type=Path, default=Path("planning-bench.csv"))
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\nEvery run times")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--cases",
+        default="blocks-7:25,blocks-4:50",
+        help="comma-separated PROBLEM[@CONTROLLER]:PARTICLES or PROBLEM[@CONTROLLER]:cbst "
+        "(default: %(default)s)",
+    )
+    parser.add_argument(
+        "--configs",
+        default="local:1,local:2",
+        help="comma-separated local:WORKERS or dask:WORKERS (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--baseline",
+        default=None,
+        metavar="GITREF",
+        help="also run the code of this commit, alternating with this checkout's (old / new)",
+    )
+    parser.add_argument(
+        "--repeats", type=int, default=3, help="runs per case, config and code (default: 3)"
+    )
+    parser.add_argument("--seed", type=int, default=0, help="the planner's seed (default: 0)")
+    parser.add_argument(
+        "--output",
+        type=Path,
+        default=Path("planning-bench.csv"),
+        help="CSV the rows are appended to as they are measured (default: %(default)s)",
+    )
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
