@@ -77,6 +77,7 @@ from arrange_up.model.world import (
 )
 from arrange_up.physics.bench import scene
 from arrange_up.physics.settings import (
+    COMPLIANT_VALUES,
     DEFAULT_SETTINGS,
     SERVO_VALUES,
     PhysicsSettings,
@@ -155,6 +156,14 @@ ALTERNATIVES: dict[str, dict] = {
         "iterations": 5,
         "sleep_time": 0.05,
     },
+    # a coarser time step under today's compliant values (issue 15's last alternative: the
+    # set point's travel at the push speed is most of a push's steps, so only a longer step
+    # takes fewer of them)
+    "compliant values (the defaults, dt 1/240)": dict(COMPLIANT_VALUES),
+    "compliant values, dt 1/200": {**COMPLIANT_VALUES, "dt": 1.0 / 200.0},
+    "compliant values, dt 1/180": {**COMPLIANT_VALUES, "dt": 1.0 / 180.0},
+    "compliant values, dt 1/160": {**COMPLIANT_VALUES, "dt": 1.0 / 160.0},
+    "compliant values, dt 1/120": {**COMPLIANT_VALUES, "dt": 1.0 / 120.0},
 }
 
 
