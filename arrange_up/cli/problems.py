@@ -16,6 +16,7 @@ from arrange_up.io.domains import (
 )
 from arrange_up.io.files import text_place
 from arrange_up.io.pddl import PddlExportError, write_pddl_problem
+from arrange_up.io.pddl_reader import problem_name_place
 from arrange_up.io.planfile import write_text_atomic
 
 
@@ -127,9 +128,9 @@ def _name_place(path: Path) -> str:
     """``:LINE:COLUMN`` of the problem's name in the file (a YAML file's top-level ``name:``
     value, a PDDL file's ``(problem NAME)``), or "" when it is not found."""
     text = path.read_text(encoding="utf-8", errors="replace")
-    pattern = r"\(\s*problem\s+" if path.suffix.lower() == ".pddl" else r"(?m)^name[ \t]*:[ \t]*"
-    match = re.search(pattern, text, flags=re.IGNORECASE)
-    if match is None:
-        return ""
-    line, column = text_place(text, match.end())
-    return f":{line}:{column}"
+    if path.suffix.lower() == ".pddl":
+        place = problem_name_place(text)
+    else:
+        match = re.search(r"(?m)^name[ \t]*:[ \t]*", text)
+        place = None if match is None else text_place(text, match.end())
+    return "" if place is None else f":{place[0]}:{place[1]}"

@@ -47,6 +47,7 @@ __all__ = [
     "load_pddl_problem",
     "load_pddl_problem_text",
     "problem_from_up",
+    "problem_name_place",
 ]
 
 Checked = tuple[ArrangementProblem | None, list[Diagnostic]]
@@ -186,6 +187,18 @@ def problem_from_up(
     return problem
 
 
+#: ``(problem NAME``: the problem's name, group 1.
+_PROBLEM_NAME = re.compile(r"\(\s*problem\s+([^\s()]+)", flags=re.IGNORECASE)
+
+
+def problem_name_place(text: str) -> tuple[int, int] | None:
+    """Line and column (1-based) of the problem's name in the PDDL ``text`` (comments skipped),
+    or None when it names none."""
+    source = _Text(text)
+    match = _PROBLEM_NAME.search(source.code)
+    return source.position(match.start(1)) if match else None
+
+
 class _Text:
     """The PDDL source of a problem: names as written, and positions of things in it."""
 
@@ -225,7 +238,7 @@ class _Text:
         return match.group(1) if match else None
 
     def problem_name(self) -> str | None:
-        match = re.search(r"\(\s*problem\s+([^\s()]+)", self.code, flags=re.IGNORECASE)
+        match = _PROBLEM_NAME.search(self.code)
         return match.group(1) if match else None
 
     def up_writer_name(self) -> str | None:

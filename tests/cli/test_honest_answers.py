@@ -127,6 +127,21 @@ def test_check_still_refuses_two_problems_of_one_name_in_a_folder(tmp_path):
     assert f"two.yaml:{line}:7: error: name: problem name" in result.output
 
 
+def test_a_pddl_name_clash_is_reported_at_the_name_not_at_a_comment(tmp_path):
+    text = (REPOSITORY / "domains" / "blocks-1.pddl").read_text()
+    (tmp_path / "one.pddl").write_text(text)
+    (tmp_path / "two.pddl").write_text("; an old copy said (problem decoy)\n" + text)
+    result = run("check", str(tmp_path / "one.pddl"), str(tmp_path / "two.pddl"))
+    assert result.exit_code == 1
+    lines = ("; comment\n" + text).splitlines()
+    line, column = next(
+        (n, t.lower().index("(problem") + len("(problem ") + 1)
+        for n, t in enumerate(lines, 1)
+        if "(problem" in t.lower() and not t.startswith(";")
+    )
+    assert f"two.pddl:{line}:{column}: error: name: problem name 'blocks-1'" in result.output
+
+
 def test_check_reports_a_folder_or_a_missing_file_and_checks_the_rest(tmp_path):
     missing = tmp_path / "missing.yaml"
     result = run("check", str(tmp_path), "blocks-1", str(missing), "blocks-2")
