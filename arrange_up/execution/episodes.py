@@ -258,6 +258,15 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
         except (ValueError, KeyError, TypeError) as error:
             handle.close()
             raise RecordFileError(f"{path}:{number}: not an episode record: {error}") from None
+        earlier = episodes.get(record.episode)
+        if earlier is not None and earlier != record:
+            # as the evaluation's records: a conflicting copy would change the count silently
+            handle.close()
+            raise RecordFileError(
+                f"{path}:{number}: episode {record.episode} is recorded twice with different "
+                "outcomes; the file was edited or written by something else: use another "
+                "record file or delete it"
+            )
         episodes[record.episode] = record
     return handle, episodes
 

@@ -181,6 +181,14 @@ def test_episodes_resume_from_their_record(blocks2, tmp_path):
     cut = run_episodes(problem, actions, episodes=3, seed=1, settings=settings, record=record)
     assert cut.resumed == 3 and cut.episodes == again.episodes
     assert record.read_text().count("\n") == 4
+    # an episode recorded twice with different outcomes is refused, not read as the last one
+    copy = {**json.loads(lines[1]), "actions": 5}
+    assert copy != json.loads(lines[1])
+    kept = record.read_text()
+    record.write_text(kept + json.dumps(copy) + "\n")
+    with pytest.raises(ValueError, match=r":5: episode 0 is recorded twice"):
+        run_episodes(problem, actions, episodes=3, seed=1, settings=settings, record=record)
+    record.write_text(kept)
     other = ClosedLoopSettings(filter_particles=9)
     with pytest.raises(ValueError, match="another closed-loop run"):
         run_episodes(problem, actions, episodes=1, seed=1, settings=other, record=record)
