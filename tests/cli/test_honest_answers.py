@@ -130,10 +130,11 @@ def test_check_still_refuses_two_problems_of_one_name_in_a_folder(tmp_path):
 def test_a_pddl_name_clash_is_reported_at_the_name_not_at_a_comment(tmp_path):
     text = (REPOSITORY / "domains" / "blocks-1.pddl").read_text()
     (tmp_path / "one.pddl").write_text(text)
-    (tmp_path / "two.pddl").write_text("; an old copy said (problem decoy)\n" + text)
+    decoy = "; an old copy said (problem decoy)\n"
+    (tmp_path / "two.pddl").write_text(decoy + text)
     result = run("check", str(tmp_path / "one.pddl"), str(tmp_path / "two.pddl"))
     assert result.exit_code == 1
-    lines = ("; comment\n" + text).splitlines()
+    lines = (decoy + text).splitlines()
     line, column = next(
         (n, t.lower().index("(problem") + len("(problem ") + 1)
         for n, t in enumerate(lines, 1)
