@@ -29,8 +29,9 @@ Backends
   process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
   seconds and respawned by the next batch. Each worker watches its parent
   (:func:`_end_with_parent`) and ends within :data:`PARENT_POLL` seconds of the parent's
-  death, even a SIGKILL that gives the parent no chance to stop its pool. Interrupting a
-  batch cancels its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
+  death, even a SIGKILL that gives the parent no chance to stop its pool. Workers ignore
+  SIGINT (:func:`_init_worker`): interrupting is the parent's; interrupting a batch cancels
+  its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
   executor wrapper cannot take over an executor that ``get_reusable_executor`` created, so
   mixing the two in one process fails with ``AttributeError: _temp_folder_manager``.)
 * ``"dask"``: :class:`DaskRunner`, a ``dask.distributed`` client. With no ``scheduler`` address
@@ -75,10 +76,11 @@ import logging
 import math
 import os
 import pickle
+import signal
 import threading
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, wait
 from itertools import islice
 from typing import Any, Generic, TypeVar
@@ -131,6 +133,7 @@ def _apply_chunk(fn: Callable[[T], R], chunk: Sequence[T]) -> list[tuple[T, R]]:
 
 class Runner:
     """Maps a function over items, in chunks, yielding ``(item, result)`` as chunks finish.
+    :meth:`map` is a generator: closing it early cancels the chunks not yet started.
 
     ``backend`` names the backend and ``workers`` the number of tasks it runs at once.
     """
@@ -140,7 +143,7 @@ class Runner:
 
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
-    ) -> Iterator[tuple[T, R]]:  # pragma: no cover - abstract
+    ) -> Generator[tuple[T, R], None, None]:  # pragma: no cover - abstract
         raise NotImplementedError
 
     def session(self, fn: Callable[[Any, T], R], context: Any) -> Session[T, R]:
@@ -228,7 +231,7 @@ class SerialRunner(Runner):
 
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
-    ) -> Iterator[tuple[T, R]]:
+    ) -> Generator[tuple[T, R], None, None]:
         _check_chunksize(chunksize)
         for item in items:
             yield item, fn(item)
@@ -249,9 +252,21 @@ IDLE_TIMEOUT = 10
 PARENT_POLL = 0.5
 
 
+def _init_worker(parent: int) -> None:
+    """Worker initializer: leave interrupts to the parent, and end with it
+    (:func:`_end_with_parent`).
+
+    A Ctrl-C on a terminal reaches the whole process group, workers included. Raised inside a
+    task, it would fail that task's chunk and turn the parent's orderly stop (a planning run
+    that keeps its plan and the validation rollouts already done) into a traceback; the parent
+    decides instead, and cancels the tasks it no longer wants.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _end_with_parent(parent)
+
+
 def _end_with_parent(parent: int) -> None:
-    """Worker initializer: end this worker as soon as process ``parent`` (the one whose pool
-    it serves) is gone.
+    """End this worker as soon as process ``parent`` (the one whose pool it serves) is gone.
 
     A killed parent cannot stop its pool, and loky's workers would otherwise live on until
     their idle timeout or longer, holding cores. An orphan is adopted by another process, so
@@ -281,7 +296,7 @@ def local_executor(workers: int) -> Any:
     return get_reusable_executor(
         max_workers=workers,
         timeout=IDLE_TIMEOUT,
-        initializer=_end_with_parent,
+        initializer=_init_worker,
         initargs=(os.getpid(),),
     )
 
@@ -298,7 +313,7 @@ class LocalRunner(Runner):
 
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
-    ) -> Iterator[tuple[T, R]]:
+    ) -> Generator[tuple[T, R], None, None]:
         _check_chunksize(chunksize)
         executor = local_executor(self.workers)
         chunks = _chunks(items, chunksize)
@@ -452,7 +467,7 @@ class DaskRunner(Runner):
 
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
-    ) -> Iterator[tuple[T, R]]:
+    ) -> Generator[tuple[T, R], None, None]:
         from distributed import as_completed  # an optional dependency (see the module doc)
 
         _check_chunksize(chunksize)

@@ -19,6 +19,7 @@ from arrange_up.cli.shared import (
     document_summary,
     echo_json,
     fail,
+    first_interrupt_stops,
     json_option,
     library_default,
     load_problem,
@@ -89,7 +90,9 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     default=None,
     help=f"Node limit (default: the problem's planning.max_nodes, else {DEFAULT_MAX_NODES}).",
 )
-@timeout_option("Give up after this many seconds.")
+@timeout_option(
+    "Give up after this many seconds (validation included: a plan found in time is kept)."
+)
 @click.option(
     "--heuristic",
     default=library_default(run_plan, "heuristic"),
@@ -166,11 +169,17 @@ def plan(
     A particle plan is conformant for its particles only, so it is checked on twice --particles
     fresh rollouts, at least 60 (--validate); their failed starts become further particles of up
     to three more searches, and the line after the statistics says how the returned plan did.
-    The rollouts are seeded apart from evaluate's, which stays a fresh test.
+    The rollouts are seeded apart from evaluate's, which stays a fresh test. --timeout covers
+    them too: a plan found in time is returned with the rollouts that fitted, and the line says
+    how many of the asked-for ones ran.
+
+    Ctrl-C stops the run in order: during a search, the status is cancelled (written to
+    --output like any other); during a validation, the plan found is kept with the rollouts
+    already run. A second Ctrl-C aborts at once and writes nothing.
 
     Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted: the
-    candidates ran out, unsolvable: proven, e.g. a goal part larger than the table), 2 bad
-    input. An unsolved run prints one line of why.
+    candidates ran out, unsolvable: proven, e.g. a goal part larger than the table, cancelled:
+    interrupted) or aborted, 2 bad input. An unsolved run prints one line of why.
     """
     check_semantics(semantics)
     try:
@@ -184,7 +193,10 @@ def plan(
     if workers is None:
         workers = 1 if semantics == "deterministic" else available_cores()
     try:
-        with terminal_progress(TextColumn("{task.description}")) as display:
+        with (
+            first_interrupt_stops("the search and the validation") as interrupted,
+            terminal_progress(TextColumn("{task.description}")) as display,
+        ):
             update = None
             if display is not None:
                 task = display.add_task("starting…", total=None)
@@ -208,6 +220,7 @@ def plan(
                 progress=update,
                 model=model,
                 validate=validate,
+                should_stop=interrupted,
             )
     except BackendUnavailableError as error:  # dask missing, or the scheduler unreachable
         fail(f"--backend {backend}: {error}")
@@ -215,7 +228,7 @@ def plan(
         if model is None:
             raise
         fail(f"--model {model}: {error}")
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # the second Ctrl-C
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
     document = result.document(loaded, model)
     if output:

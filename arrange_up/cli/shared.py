@@ -14,8 +14,10 @@ import inspect
 import json
 import math
 import os
+import signal
 import sys
 import tempfile
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -270,6 +272,30 @@ def terminal_progress(*columns: str | ProgressColumn) -> Iterator[Progress | Non
         return
     with Progress(*columns, console=Console(stderr=True), transient=True) as display:
         yield display
+
+
+@contextmanager
+def first_interrupt_stops(what: str) -> Iterator[Callable[[], bool]]:
+    """While the block runs, the first Ctrl-C (SIGINT) asks for an orderly stop instead of
+    raising: the block polls the yielded callable, which turns True, and keeps what it has
+    computed. A line on stderr says so and that a second Ctrl-C aborts (it raises
+    ``KeyboardInterrupt`` as usual). ``what`` names what stops (``"the search"``). Outside the
+    main thread, where no handler can be set, the callable stays False."""
+    asked: list[bool] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        asked.append(True)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        click.echo(f"interrupt: stopping {what}; Ctrl-C again to abort", err=True)
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield lambda: bool(asked)
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def echo_json(data: Any) -> None:

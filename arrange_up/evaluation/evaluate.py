@@ -30,7 +30,7 @@ on Dask) and gathers them.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
 
@@ -75,6 +75,7 @@ def evaluate_plan(
     chunksize: int | None = None,
     keep_records: bool = False,
     landing: str = "fail",
+    should_stop: Callable[[], bool] | None = None,
 ) -> Reliability:
     """Estimate how often ``actions`` achieve ``problem``'s goal under its full noise.
 
@@ -106,6 +107,12 @@ def evaluate_plan(
         ``"shove"`` (the physics resolves the overlap); see
         :mod:`arrange_up.evaluation.rollouts`. Recorded in the record file's header and in the
         result.
+    should_stop
+        Polled before the first rollout and after every finished one; once it returns True no
+        further rollout is started, and the result covers the rollouts finished so far (its
+        ``trials`` is how many, fewer than ``rollouts``; rollouts still running are dropped).
+        A caller that passes it compares ``trials`` with ``rollouts`` before calling the
+        estimate complete. Planning uses it to hold a time limit while it validates a plan.
 
     Raises
     ------
@@ -153,12 +160,13 @@ def evaluate_plan(
         todo = [i for i in range(rollouts) if i not in records]
         if progress is not None:
             progress(EvaluationProgress(resumed, rollouts, successes, 0.0, resumed))
-        if todo:
+        if todo and not (should_stop is not None and should_stop()):
             runner = get_runner(backend, workers, scheduler)
             runner_workers = runner.workers
             size = chunksize or auto_chunksize(len(todo), runner.workers)
             context = RolloutContext(f"{phash} {lhash} {landing}", problem, actions, seed, landing)
-            for index, result in runner.map(partial(rollout_task, context), todo, size):
+            results = runner.map(partial(rollout_task, context), todo, size)
+            for index, result in results:
                 records[index] = result
                 successes += result.success
                 if file is not None:
@@ -173,14 +181,18 @@ def evaluate_plan(
                             resumed,
                         )
                     )
+                if should_stop is not None and should_stop():
+                    # every runner's map is a generator: closing it cancels its queued chunks
+                    results.close()
+                    break
     finally:
         if file is not None:
             file.close()
 
-    ordered = [records[i] for i in range(rollouts)]
+    ordered = [records[i] for i in sorted(records)]
     return Reliability(
         successes=successes,
-        trials=rollouts,
+        trials=len(ordered),
         failures=FailureBreakdown.from_records(ordered),
         seed=seed,
         elapsed=time.perf_counter() - started,

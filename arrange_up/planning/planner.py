@@ -34,6 +34,7 @@ from arrange_up.planning.validation import (
     Validation,
     ValidationRound,
     check_validate,
+    choose_round,
     default_validation_rollouts,
     validate_plan,
 )
@@ -284,7 +285,9 @@ def plan(
     max_nodes
         Limit on expanded nodes; defaults to the problem's ``planning.max_nodes`` or 5000.
     timeout
-        Wall-clock seconds; the search returns status ``timeout`` when it runs out.
+        Wall-clock seconds for the whole run, validation included: the search returns status
+        ``timeout`` when it runs out; a plan found before it is returned with the validation
+        rollouts that fitted (:attr:`PlanResult.validation` says how many ran).
     heuristic
         One of :data:`arrange_up.planning.heuristics.HEURISTICS` (default: the thesis's inadmissible
         per-dimension count with the part-ordering filter, its fastest configuration).
@@ -387,6 +390,17 @@ def plan(
             start=start,
         )
 
+    stopped_by: list[str] = []  # what ended the validation early, once it has
+
+    def stop() -> bool:
+        """The time limit has come, or the caller asks to stop (and which, remembered)."""
+        if not stopped_by:
+            if timeout is not None and time.monotonic() - started >= timeout:
+                stopped_by.append("the time limit")
+            elif should_stop is not None and should_stop():
+                stopped_by.append("a stop request")
+        return bool(stopped_by)
+
     result = search(start, particles)
     if not validate or not result.solved:
         return result
@@ -403,7 +417,7 @@ def plan(
         if not result.solved:
             rounds.append(ValidationRound(size, result.status, result.stats["expanded"], None))
             break
-        successes, failed = validate_plan(
+        run, successes, failed = validate_plan(
             problem,
             result.actions,  # type: ignore[arg-type]  # set when solved
             rollouts=validate,
@@ -412,21 +426,30 @@ def plan(
             workers=workers,
             backend=backend,
             scheduler=scheduler,
+            should_stop=stop,
         )
-        rounds.append(ValidationRound(size, result.status, result.stats["expanded"], successes))
+        rounds.append(
+            ValidationRound(size, result.status, result.stats["expanded"], successes, run)
+        )
         found.append(result)
-        out_of_time = timeout is not None and time.monotonic() - started >= timeout
-        if not failed or out_of_time or (should_stop is not None and should_stop()):
+        if not failed or stop():
             break
-    planned = [i for i, r in enumerate(rounds) if r.successes is not None]
-    chosen = max(planned, key=lambda i: (rounds[i].successes, i))
-    best = found[planned.index(chosen)]
+    chosen = choose_round(tuple(rounds))
+    best = found[chosen]  # only the last round can be without a plan
     statistics = dataclasses.replace(best.statistics, elapsed=time.monotonic() - started)
     return dataclasses.replace(
         best,
         particles=particles,
         statistics=statistics,
-        validation=Validation(validate, tuple(rounds), chosen),
+        validation=Validation(
+            validate,
+            tuple(rounds),
+            chosen,
+            # a stop that came after a round's last rollout cut nothing short
+            stopped_by[0]
+            if stopped_by and any(r.run not in (None, validate) for r in rounds)
+            else None,
+        ),
     )
 
 

@@ -14,10 +14,16 @@ The validation rollouts are an evaluation with a seed of their own, derived from
 seed and the round (:func:`validation_seed`), never a small integer: an evaluation a user runs
 (seed 0 by default) does not meet the starts the planner was shown, so its figure stays a
 fresh test set.
+
+A planning run's time limit holds while it validates: the rollouts stop when it comes, and the
+round records how many ran (:attr:`ValidationRound.run`). A plan validated on fewer rollouts
+than asked is still returned, with its line saying so; it is never presented as checked on
+all of them.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,6 +40,7 @@ __all__ = [
     "Validation",
     "ValidationRound",
     "check_validate",
+    "choose_round",
     "default_validation_rollouts",
     "validate_plan",
     "validation_seed",
@@ -88,31 +95,51 @@ def validation_seed(seed: int, round_: int) -> int:
 class ValidationRound:
     """One search of a validated planning run: the particles it searched with (the requested
     ones plus the counterexamples of the earlier rounds), its status and expanded nodes, and,
-    for a found plan, how many of the validation rollouts succeeded (``None``: no plan)."""
+    for a found plan, how many validation rollouts ran on it (``run``: all the run asked for
+    unless the time limit or a stop came first) and how many of those succeeded
+    (``successes``); both ``None`` without a plan."""
 
     particles: int
     status: str
     expanded: int
     successes: int | None
+    run: int | None = None
+
+    @property
+    def rate(self) -> float:
+        """Successes per validation rollout run (0 when none ran or there is no plan)."""
+        return self.successes / self.run if self.successes is not None and self.run else 0.0
 
     def to_json(self) -> dict[str, Any]:
         return {
             "particles": self.particles,
             "status": str(self.status),
             "expanded": self.expanded,
+            "run": self.run,
             "successes": self.successes,
         }
 
 
+def choose_round(rounds: tuple[ValidationRound, ...]) -> int:
+    """The index of the round whose plan a validated run returns: among the rounds with a plan,
+    the highest success rate on the rollouts run, then the most rollouts run, then the later
+    (it was searched with more particles). When every round ran its rollouts in full this is
+    the most successes, the later on a tie."""
+    planned = [i for i, r in enumerate(rounds) if r.successes is not None]
+    return max(planned, key=lambda i: (rounds[i].rate, rounds[i].run or 0, i))
+
+
 @dataclass(frozen=True)
 class Validation:
-    """The validation of a planning run: ``rollouts`` fresh rollouts per found plan, the rounds
-    in order, and ``chosen``, the index of the round whose plan was returned (the one with the
-    most successes, the later on a tie: it was searched with more particles)."""
+    """The validation of a planning run: ``rollouts`` fresh rollouts asked for per found plan,
+    the rounds in order, and ``chosen``, the index of the round whose plan was returned
+    (:func:`choose_round`). ``stopped_by`` names what cut a round's rollouts short (``"the time
+    limit"`` or ``"a stop request"``), ``None`` when none was."""
 
     rollouts: int
     rounds: tuple[ValidationRound, ...]
     chosen: int
+    stopped_by: str | None = None
 
     @property
     def successes(self) -> int:
@@ -122,23 +149,44 @@ class Validation:
         return successes
 
     @property
+    def run(self) -> int:
+        """Validation rollouts run on the returned plan (``rollouts`` unless the time limit or
+        a stop came first)."""
+        run = self.rounds[self.chosen].run
+        assert run is not None  # a chosen round has a plan
+        return run
+
+    @property
+    def complete(self) -> bool:
+        """True iff the returned plan ran every validation rollout asked for."""
+        return self.run == self.rollouts
+
+    @property
     def passed(self) -> bool:
-        """True iff the returned plan succeeded in every validation rollout."""
-        return self.successes == self.rollouts
+        """True iff the returned plan ran every validation rollout and succeeded in each."""
+        return self.complete and self.successes == self.rollouts
 
     def line(self) -> str:
         """One line for the command line: what the returned plan did on fresh rollouts, and
         what the extra searches were."""
         chosen = self.rounds[self.chosen]
-        text = (
-            f"validated on {self.rollouts} fresh rollouts: {self.successes} succeeded"
+        if self.complete:
+            text = f"validated on {self.rollouts} fresh rollouts: {self.successes} succeeded"
+        elif self.run:
+            text = (
+                f"validated on {self.run} of {self.rollouts} fresh rollouts (stopped by "
+                f"{self.stopped_by}): {self.successes} succeeded"
+            )
+        else:
+            text = f"not validated: {self.stopped_by} came before any of {self.rollouts} rollouts"
+        text += (
             f" (plan of search {self.chosen + 1} of {len(self.rounds)}, "
             f"{chosen.particles} particles)"
         )
         if len(self.rounds) > 1:
             text += "; searches: " + ", ".join(
                 f"{r.particles} particles {r.status}"
-                + (f" {r.successes}/{self.rollouts}" if r.successes is not None else "")
+                + (f" {r.successes}/{r.run}" if r.successes is not None else "")
                 for r in self.rounds
             )
         return text
@@ -146,9 +194,11 @@ class Validation:
     def to_json(self) -> dict[str, Any]:
         return {
             "rollouts": self.rollouts,
+            "run": self.run,
             "successes": self.successes,
             "chosen": self.chosen,
             "rounds": [r.to_json() for r in self.rounds],
+            **({"stopped_by": self.stopped_by} if self.stopped_by else {}),
         }
 
 
@@ -162,11 +212,13 @@ def validate_plan(
     workers: int = 1,
     backend: str = "local",
     scheduler: str | None = None,
-) -> tuple[int, tuple[WorldState, ...]]:
+    should_stop: Callable[[], bool] | None = None,
+) -> tuple[int, int, tuple[WorldState, ...]]:
     """Run ``rollouts`` rollouts of ``actions`` with :func:`validation_seed` ``(seed, round_)``
     (on the evaluation's runner: ``workers``, ``backend``, ``scheduler`` as for
-    :func:`~arrange_up.evaluation.evaluate.evaluate_plan`); return the successes and the
-    initial states of the failed rollouts, in rollout order."""
+    :func:`~arrange_up.evaluation.evaluate.evaluate_plan`), starting no more once
+    ``should_stop()`` returns True; return how many ran, their successes, and the initial
+    states of the failed ones, in rollout order."""
     vseed = validation_seed(seed, round_)
     reliability = evaluate_plan(
         problem,
@@ -177,6 +229,7 @@ def validate_plan(
         backend=backend,
         scheduler=scheduler,
         keep_records=True,
+        should_stop=should_stop,
     )
     assert reliability.records is not None  # asked for with keep_records
     failed = tuple(
@@ -184,4 +237,4 @@ def validate_plan(
         for record in reliability.records
         if not record.success
     )
-    return reliability.successes, failed
+    return reliability.trials, reliability.successes, failed

@@ -514,6 +514,7 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
         if outcome.validation is not None:
             metrics.update(
                 validation_rollouts=str(outcome.validation.rollouts),
+                validation_run=str(outcome.validation.run),
                 validation_successes=str(outcome.validation.successes),
                 validation_searches=str(len(outcome.validation.rounds)),
             )

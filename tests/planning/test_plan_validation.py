@@ -4,6 +4,7 @@ from join the particles of the next search (``arrange_up.planning.validation``).
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import pytest
@@ -14,8 +15,14 @@ from arrange_up.cli.plan import _status_line
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.rollouts import rollout_start, trace_rollout
 from arrange_up.io.yaml_problem import load_problem
+from arrange_up.planning import validation as validation_module
 from arrange_up.planning.planner import plan
-from arrange_up.planning.validation import VALIDATION_REPLANS, validation_seed
+from arrange_up.planning.validation import (
+    VALIDATION_REPLANS,
+    ValidationRound,
+    choose_round,
+    validation_seed,
+)
 
 # One block centred on its goal x but spread too wide: two particles do not show the spread,
 # and their plan fails about half of the fresh rollouts.
@@ -141,3 +148,55 @@ def test_validate_with_another_semantics_exits_2() -> None:
     )
     assert result.exit_code == 2
     assert "--validate checks particle plans" in result.output
+
+
+def test_the_time_limit_holds_while_a_plan_is_validated(narrow) -> None:
+    # A million rollouts take hours; the search takes a fraction of a second. Before the
+    # limit held during validation, the run took as long as the rollouts.
+    started = time.monotonic()
+    result = plan(narrow, particles=2, seed=0, workers=1, validate=1_000_000, timeout=2.0)
+    assert time.monotonic() - started < 30
+    validation = result.validation
+    assert result.solved and validation is not None
+    assert validation.stopped_by == "the time limit"
+    assert 0 <= validation.run < 1_000_000 and not validation.complete
+    assert not validation.passed  # never presented as checked on every rollout
+    assert "of 1000000 fresh rollouts (stopped by the time limit)" in validation.line() or (
+        validation.run == 0 and "not validated: the time limit came before" in validation.line()
+    )
+    assert result.validation.to_json()["run"] == validation.run
+
+
+def test_a_stop_request_keeps_the_plan_and_the_rollouts_already_run(narrow, monkeypatch) -> None:
+    asked: list[bool] = []
+
+    def evaluate_then_ask(*args, **kwargs):
+        # the caller asks to stop once four validation rollouts have finished
+        def progress(update) -> None:
+            if update.done >= 4:
+                asked.append(True)
+
+        return evaluate_plan(*args, progress=progress, **kwargs)
+
+    monkeypatch.setattr(validation_module, "evaluate_plan", evaluate_then_ask)
+    result = plan(
+        narrow, particles=2, seed=0, workers=1, validate=10, should_stop=lambda: bool(asked)
+    )
+    validation = result.validation
+    # one search, four rollouts: the stop is not mistaken for a failed validation to search on
+    assert result.solved and len(validation.rounds) == 1
+    assert (validation.run, validation.rollouts, validation.stopped_by) == (4, 10, "a stop request")
+    check = evaluate_plan(narrow, result.actions, rollouts=4, seed=validation_seed(0, 0), workers=1)
+    assert validation.successes == check.successes
+    assert "validated on 4 of 10 fresh rollouts (stopped by a stop request)" in validation.line()
+
+
+def test_the_round_returned_is_the_best_rate_on_the_rollouts_run() -> None:
+    rounds = (
+        ValidationRound(2, "solved", 5, 8, 10),
+        ValidationRound(4, "solved", 5, 3, 3),  # cut short, but all of its rollouts succeeded
+        ValidationRound(6, "timeout", 5, None),
+    )
+    assert choose_round(rounds) == 1
+    # complete rounds: the most successes, the later on a tie
+    assert choose_round((rounds[0], ValidationRound(4, "solved", 5, 8, 10))) == 1

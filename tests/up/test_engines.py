@@ -139,7 +139,7 @@ def test_a_particle_plan_reports_its_validation():
     params = {"particles": 2, "seed": 0, "validate": 6}
     result = _solve(to_up(load("blocks-1")), params=params, timeout=60)
     assert result.status is Status.SOLVED_SATISFICING
-    assert result.metrics["validation_rollouts"] == "6"
+    assert result.metrics["validation_rollouts"] == result.metrics["validation_run"] == "6"
     assert 0 <= int(result.metrics["validation_successes"]) <= 6
     assert int(result.metrics["validation_searches"]) >= 1
     assert any("validated on 6 fresh rollouts" in log.message for log in result.log_messages)
