@@ -389,3 +389,17 @@ def test_the_planner_engine_runs_its_successors_where_told_with_the_same_plan():
         OneshotPlanner(name="arrange-up", params={"backend": "ray"})
     with pytest.raises(ValueError, match="scheduler address needs"):
         OneshotPlanner(name="arrange-up", params={"scheduler": "tcp://127.0.0.1:1"})
+
+
+def test_a_problem_read_by_pddlreader_has_lowercase_names_and_the_same_nominal_plan():
+    # docs/tutorial.md: unified-planning's reader lowercases names; a deterministic plan (no
+    # noise drawn from the names) is the command line's, up to their case
+    path = domains_dir() / "blocks-2.pddl"
+    read = PDDLReader().parse_problem(str(domain_path()), str(path))
+    assert {spec.name for spec in load("blocks-2").objects} >= {"A", "B"}
+    assert {spec.name for spec in from_up(read).objects} >= {"a", "b", "paddle"}
+    with pytest.warns(UserWarning, match="cannot establish whether arrange-up can solve"):
+        from_pddl = _solve(read)
+    from_yaml = _solve(to_up(load("blocks-2")))
+    assert from_pddl.status is from_yaml.status is Status.SOLVED_SATISFICING
+    assert str(from_pddl.plan).lower() == str(from_yaml.plan).lower()
