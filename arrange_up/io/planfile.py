@@ -322,10 +322,16 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
     raw_actions = document["actions"]
     if not isinstance(raw_actions, list):
         raise PlanFileError(f"{path}: actions: expected a list, got {_json_kind(raw_actions)}")
-    actions = tuple(
-        action_from_json(item, units, problem, f"{path}: actions[{i}]")
-        for i, item in enumerate(raw_actions)
-    )
+    try:
+        actions = tuple(
+            action_from_json(item, units, problem, f"{path}: actions[{i}]")
+            for i, item in enumerate(raw_actions)
+        )
+    except PlanFileError as error:
+        whose = recorded.get("name")
+        if isinstance(whose, str) and whose != problem.name:  # the likely cause: say it
+            raise PlanFileError(f"{error} (the file was planned for problem {whose!r})") from None
+        raise
     return actions, document
 
 

@@ -453,6 +453,7 @@ def test_cli_bad_input_exits_2_cleanly(plan_file, tmp_path):
     write_json_atomic(foreign, doc)
     done = runner.invoke(main, ["evaluate", "blocks-1", str(foreign)])
     assert done.exit_code == 2 and "expected an object of problem 'blocks-1'" in done.stderr
+    assert "got 'B' (the file was planned for problem 'blocks-2')" in done.stderr
 
 
 def test_cli_without_dask_says_how_to_install_it(plan_file, monkeypatch):
