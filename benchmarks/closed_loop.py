@@ -38,33 +38,75 @@ from arrange_up.planning.planner import plan
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
     parser.add_argument(
         "--problems",
         default="tz-mating",
         help="Comma-separated problem names; NAME@CONTROLLER runs a problem under that "
         "controller (blocks-4@servo: the servo, whose CBST model plans it).",
     )
-    parser.add_argument("--episodes", type=int, default=20)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--sense", default="paddle")
-    parser.add_argument("--noise-scale", type=float, default=1.0)
-    parser.add_argument("--plan-semantics", default="deterministic")
-    parser.add_argument("--plan-particles", type=int, default=10)
-    parser.add_argument("--semantics", default="deterministic")
-    parser.add_argument("--particles", type=int, default=10)
-    parser.add_argument("--max-nodes", type=int, default=300)
-    parser.add_argument("--replan-budget", type=float, default=30.0)
     parser.add_argument(
-        "--filter-particles", type=int, default=ClosedLoopSettings().filter_particles
+        "--episodes", type=int, default=20, help="Episodes per problem, open and closed loop."
     )
-    parser.add_argument("--landing", default="fail", choices=("fail", "shove"))
+    parser.add_argument(
+        "--seed", type=int, default=0, help="Episode i's world and noise draw from (seed, i)."
+    )
+    parser.add_argument(
+        "--sense",
+        default="paddle",
+        help="Closed loop's observations: paddle (its final pose after a push), poses (noisy "
+        "part poses, a camera) or none.",
+    )
+    parser.add_argument(
+        "--noise-scale",
+        type=float,
+        default=1.0,
+        help="The executor's noise as a multiple of the problem's modelled noise (2: model "
+        "error the planner does not know of).",
+    )
+    parser.add_argument(
+        "--plan-semantics",
+        default="deterministic",
+        help="Semantics of the first plan, which open loop executes as it is.",
+    )
+    parser.add_argument(
+        "--plan-particles", type=int, default=10, help="Particles of the first plan's search."
+    )
+    parser.add_argument("--semantics", default="deterministic", help="Semantics of the replans.")
+    parser.add_argument(
+        "--particles", type=int, default=10, help="Particles of each replan's search."
+    )
+    parser.add_argument("--max-nodes", type=int, default=300, help="Node limit of each replan.")
+    parser.add_argument(
+        "--replan-budget", type=float, default=30.0, help="Seconds each replan may take."
+    )
+    parser.add_argument(
+        "--filter-particles",
+        type=int,
+        default=ClosedLoopSettings().filter_particles,
+        help="Particles of the belief the observations update.",
+    )
+    parser.add_argument(
+        "--landing",
+        default="fail",
+        choices=("fail", "shove"),
+        help="A push whose paddle is put down onto a part: fails the action, or the physics "
+        "resolves the overlap.",
+    )
     parser.add_argument(
         "--no-adapt",
         action="store_true",
         help="Keep the modelled noise after a model failure (ClosedLoopSettings.adapt off).",
     )
-    parser.add_argument("--output-dir", type=Path, default=Path("closed-loop-results"))
+    parser.add_argument(
+        "--output-dir",
+        type=Path,
+        default=Path("closed-loop-results"),
+        help="Where the episode records, first plans and closed_loop.json go (resumed).",
+    )
     parser.add_argument(
         "--table",
         action="store_true",
