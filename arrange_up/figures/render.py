@@ -14,8 +14,9 @@ storyboard with one panel per plan action, a report) can reuse them:
 * :func:`draw_goal`: an absolute goal's target outlines and tolerance regions, or a relative
   goal's arrangement around the reference part.
 
-Everything is in inches (the problem's internal unit), whatever units the file used. Figures
-are drawn with the non-interactive Agg backend (:func:`arrange_up.figures.backend.pyplot`).
+Everything is drawn in inches (the problem's internal unit), whatever units the file used; the
+axes are ticked and labelled, and the notes written, in the file's own units. Figures are drawn
+with the non-interactive Agg backend (:func:`arrange_up.figures.backend.pyplot`).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 from shapely.geometry import Polygon
 
 from arrange_up.figures.backend import pyplot, save_figure
@@ -41,6 +43,7 @@ from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.se2 import compose, rotate
 from arrange_up.io.domains import first_sentence
 from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, ObjectSpec, Pose
+from arrange_up.model.units import Units
 
 __all__ = [
     "PART_COLORS",
@@ -58,6 +61,7 @@ __all__ = [
     "heatmap_figure",
     "object_color",
     "off_table_note",
+    "unit_axes",
     "write_heatmap",
 ]
 
@@ -137,12 +141,15 @@ def _is_zero(half_widths: Sequence[float]) -> bool:
     return all(abs(v) < 1e-12 for v in half_widths)
 
 
-def _describe_shape(spec: ObjectSpec) -> str:
+def _describe_shape(spec: ObjectSpec, units: Units) -> str:
+    """The size of ``spec``'s shape in ``units``' length unit."""
+    out = units.length_out
     if spec.shape.box is not None:
         w, h = spec.shape.box
-        return f"{w:.3g} x {h:.3g} in"
+        return f"{out(w):.3g} x {out(h):.3g} {units.length}"
     xmin, ymin, xmax, ymax = spec.shape.extent
-    return f"{spec.shape.name or 'polygon'}, {xmax - xmin:.3g} x {ymax - ymin:.3g} in"
+    size = f"{out(xmax - xmin):.3g} x {out(ymax - ymin):.3g} {units.length}"
+    return f"{spec.shape.name or 'polygon'}, {size}"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -444,7 +451,7 @@ def off_table_note(problem: ArrangementProblem) -> str:
     for kind, title in ((ObjectKind.MANIPULATOR, "manipulator"), (ObjectKind.FIXTURE, "fixture")):
         specs = [s for s in problem.of_kind(kind) if s.name not in on_table]
         for spec in specs:
-            lines.append(f"{title}: {spec.name} ({_describe_shape(spec)})")
+            lines.append(f"{title}: {spec.name} ({_describe_shape(spec, problem.units)})")
     return "\n".join(lines)
 
 
@@ -531,12 +538,38 @@ def _relative_bounds(problem: ArrangementProblem) -> list[tuple[float, float, fl
     return boxes
 
 
-def _style_axes(ax: Axes, xlim: Any, ylim: Any) -> None:
+class _UnitLocator(MaxNLocator):
+    """Ticks at round values of a length unit on axes drawn in inches (``factor`` inches per
+    unit)."""
+
+    def __init__(self, factor: float) -> None:
+        super().__init__(nbins="auto", steps=[1, 2, 2.5, 5, 10])
+        self.factor = factor
+
+    def tick_values(self, vmin: float, vmax: float) -> Any:
+        return super().tick_values(vmin / self.factor, vmax / self.factor) * self.factor
+
+
+def unit_axes(ax: Axes, units: Units, xlabel: str = "x", ylabel: str = "y") -> None:
+    """Label ``ax`` (drawn in inches) ``xlabel (unit)`` and ``ylabel (unit)`` in ``units``'
+    length unit, ticked at round values of that unit (inches keep matplotlib's own ticks)."""
+    ax.set_xlabel(f"{xlabel} ({units.length})")
+    ax.set_ylabel(f"{ylabel} ({units.length})")
+    if units.length == "in":
+        return
+    factor = units.length_factor
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_locator(_UnitLocator(factor))
+        axis.set_major_formatter(
+            FuncFormatter(lambda v, _: f"{round(v / factor, 9) + 0.0:g}".replace("-", "\u2212"))
+        )
+
+
+def _style_axes(ax: Axes, xlim: Any, ylim: Any, units: Units, what: str = "") -> None:
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (in)")
-    ax.set_ylabel("y (in)")
+    unit_axes(ax, units, f"x{what}", f"y{what}")
     ax.grid(True, linewidth=0.3, alpha=0.5)
     ax.set_axisbelow(True)
 
@@ -575,18 +608,19 @@ def problem_figure(problem: ArrangementProblem, *, title: str | None = None) -> 
         ax.set_title("start and goal", fontsize=10)
     else:
         draw_relative_goal(goal_ax, problem)
-        _style_axes(goal_ax, (rx0, rx1), (ry0, ry1))
-        goal_ax.set_xlabel(f"x in {problem.goal.reference}'s frame (in)")
-        goal_ax.set_ylabel(f"y in {problem.goal.reference}'s frame (in)")
+        frame = f" in {problem.goal.reference}'s frame"
+        _style_axes(goal_ax, (rx0, rx1), (ry0, ry1), problem.units, frame)
         ax.set_title("start", fontsize=10)
-    _style_axes(ax, (x0, x1), (y0, y1))
+    _style_axes(ax, (x0, x1), (y0, y1), problem.units)
 
     side = goal_ax if goal_ax is not None else ax
     legend = draw_legend(side, problem, loc="upper left", bbox_to_anchor=(1.03, 1.0))
     note = off_table_note(problem)
     tol = problem.goal.tolerance
-    tol_text = f"goal tolerance: +-{tol[0]:.3g} in, +-{tol[1]:.3g} in, " + (
-        "any angle" if tol[2] is None else f"+-{math.degrees(tol[2]):.3g} deg"
+    units = problem.units
+    length = [f"+-{units.length_out(v):.3g} {units.length}" for v in tol[:2]]
+    tol_text = f"goal tolerance: {length[0]}, {length[1]}, " + (
+        "any angle" if tol[2] is None else f"+-{units.angle_out(tol[2]):.3g} {units.angle}"
     )
     note = f"{note}\n{tol_text}" if note else tol_text
     side.text(
@@ -824,12 +858,18 @@ def heatmap_figure(
     pad = WALL_DRAW_THICKNESS + 0.3
     boxes = [(-pad, -pad, width + pad, depth + pad)] + [box for _, box in scores.swaths]
     (x0, x1), (y0, y1) = _limits(boxes, 0.2)
-    _style_axes(ax, (max(x0, -3.0), min(x1, width + 3.0)), (max(y0, -3.0), min(y1, depth + 3.0)))
+    _style_axes(
+        ax,
+        (max(x0, -3.0), min(x1, width + 3.0)),
+        (max(y0, -3.0), min(y1, depth + 3.0)),
+        problem.units,
+    )
     placements = [c for c in scores.placements if c.fixture is not None]
     counts = {k: sum(1 for c in placements if c.status == k) for k in ("ok", "invalid", "blocked")}
     bare = scores.no_fixture
     bare_text = (
-        f"no fixture: score {bare.score:.3g}, distance {bare.distance:.3g} in"
+        f"no fixture: score {bare.score:.3g}, distance "
+        f"{problem.units.length_out(bare.distance):.3g} {problem.units.length}"
         if bare.valid and bare.score is not None
         else f"no fixture: invalid ({bare.reason})"
     )

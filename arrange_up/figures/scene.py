@@ -290,11 +290,14 @@ def draw_action(
 
 
 def describe(action: Action, problem: ArrangementProblem) -> str:
-    """A short description of ``action`` in the problem's units."""
+    """A short description of ``action`` in the problem's units: lengths with 2 decimals,
+    angles in whole degrees or in radians with 2 decimals."""
     units = problem.units
     if isinstance(action, Place):
         x, y, t = units.pose_out(action.pose)
-        return f"place {action.obj} at ({x:.2f}, {y:.2f}, {t:.0f})"
+        # rounded first: -0.02 deg reads "0", not "-0"
+        angle = f"{round(t)}" if units.angle == "deg" else f"{round(t, 2) + 0.0:.2f}"
+        return f"place {action.obj} at ({x:.2f}, {y:.2f}, {angle})"
     if isinstance(action, Push):
         return f"push {units.length_out(action.distance):.2f} {units.length}"
     return f"pick {action.obj}"
