@@ -188,10 +188,17 @@ def execute(
     )
 
     finished: list[EpisodeRecord] = []
+    read_back: set[int] = set()
+
+    def resume(numbers: tuple[int, ...]) -> None:
+        read_back.update(numbers)
+        if not as_json:
+            many = "episode" if len(numbers) == 1 else "episodes"
+            click.echo(f"  resumed {len(numbers)} {many} from {record}", err=True)
 
     def report(episode: EpisodeRecord) -> None:
         finished.append(episode)
-        if not as_json:
+        if not as_json and episode.episode not in read_back:
             outcome = "ok" if episode.success else str(episode.failure.kind)  # type: ignore[union-attr]
             click.echo(
                 f"  episode {episode.episode}: {outcome}, {episode.actions} actions, "
@@ -210,6 +217,7 @@ def execute(
             settings=settings,
             record=record,
             progress=report,
+            on_resume=resume,
         )
     except KeyboardInterrupt:
         if record:
@@ -217,9 +225,10 @@ def execute(
         else:
             kept = "they are not kept: --record FILE keeps every finished episode to resume"
         reached = sum(e.success for e in finished)
+        earlier = f"{len(read_back)} of them resumed from {record}; " if read_back else ""
         fail(
-            f"interrupted after {len(finished)} of {episodes} episodes ({reached} reached the "
-            f"goal; no result is given for part of a run); {kept}",
+            f"interrupted after {len(finished)} of {episodes} episodes ({earlier}{reached} "
+            f"reached the goal; no result is given for part of a run); {kept}",
             EXIT_NEGATIVE,
         )
     except (RecordFileError, ValueError) as error:
@@ -252,10 +261,11 @@ def execute(
     )
     median = result.median_replan_seconds
     timing = "" if median is None else f", median {median:.2f} s per replan"
+    resumed = f", {result.resumed} resumed from {record}" if result.resumed else ""
     click.echo(
         f"sense {sense}, noise x{noise_scale:g}, landing {landing}, seed {seed}: "
         f"{result.mean_replans:.2f} replans per episode ({len(result.replans)} in all{timing}), "
-        f"{result.model_failures} model failures, {rel.elapsed:.1f} s"
+        f"{result.model_failures} model failures, {rel.elapsed:.1f} s{resumed}"
     )
     if rel.failures.total:
         click.echo(f"failures: {rel.failures.total}")

@@ -282,9 +282,12 @@ def run_episodes(
     settings: ClosedLoopSettings = ClosedLoopSettings(),  # noqa: B008 - frozen
     record: str | Path | None = None,
     progress: Callable[[EpisodeRecord], None] | None = None,
+    on_resume: Callable[[tuple[int, ...]], None] | None = None,
 ) -> ClosedLoopResult:
     """Run episodes ``0 .. episodes-1`` (module docstring); ``progress`` receives each record
-    as it finishes (also those read back from ``record``)."""
+    as it finishes (also those read back from ``record``). Before any episode runs,
+    ``on_resume`` receives the numbers of the episodes read back from ``record`` (not run
+    again), if there are any."""
     started = time.monotonic()
     handle = None
     done: dict[int, EpisodeRecord] = {}
@@ -292,9 +295,12 @@ def run_episodes(
         handle, done = _open_record(
             Path(record), _header(problem, actions, sense, seed, scale, settings)
         )
-    resumed = sum(1 for i in done if i < episodes)
+    read_back = tuple(sorted(i for i in done if i < episodes))
+    resumed = len(read_back)
     out: list[EpisodeRecord] = []
     try:
+        if read_back and on_resume is not None:
+            on_resume(read_back)
         for i in range(episodes):
             found = done.get(i)
             if found is None:
