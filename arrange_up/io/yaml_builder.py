@@ -71,6 +71,8 @@ TOP_LEVEL_KEYS = (
 KIND_NAMES = tuple(kind.value for kind in ObjectKind)
 _ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
 _ARTICLE["obstacle"] = "an obstacle"
+#: The kinds that may start on the table (under 'initial'); obstacles are fixed under 'objects'.
+_MOVABLE = (ObjectKind.PART, ObjectKind.MANIPULATOR, ObjectKind.FIXTURE)
 
 
 @dataclass
@@ -422,17 +424,33 @@ class ProblemBuilder(NodeReader):
         )
         return None
 
-    def declared(self, key_node: Node, objects: dict[str, _Object], where: str) -> _Object | None:
-        """The object a key names, or ``None`` after reporting an undeclared name."""
+    def declared(
+        self,
+        key_node: Node,
+        objects: dict[str, _Object],
+        where: str,
+        kinds: tuple[ObjectKind, ...],
+        exclude: str | None = None,
+    ) -> _Object | None:
+        """The object a key names, or ``None`` after reporting an undeclared name. The report
+        suggests only the names that would be valid here: declared objects of ``kinds`` with
+        a valid name (and a kind that could be read), other than ``exclude``."""
         name = key_node.value
         if isinstance(name, str) and name in objects:
             return objects[name]
         shown = repr(name) if isinstance(name, str) else describe(name)
-        declared = ", ".join(objects) or "none"
+        valid = [
+            o.name
+            for o in objects.values()
+            if o.kind in kinds and NAME_PATTERN.fullmatch(o.name) and o.name != exclude
+        ]
+        nouns = [f"{kind.value}s" for kind in kinds]
+        noun = nouns[0] if len(nouns) == 1 else ", ".join(nouns[:-1]) + " and " + nouns[-1]
+        other = " other than the reference" if exclude is not None else ""
         self.error(
             key_node,
             f"{shown} in {where} is not declared under 'objects'; "
-            f"expected one of the declared objects ({declared})",
+            f"expected one of the declared {noun}{other} ({', '.join(valid) or 'none'})",
         )
         return None
 
@@ -447,7 +465,7 @@ class ProblemBuilder(NodeReader):
         if not self.mapping(node, expected, null_ok=True) or node.is_null:
             return entries
         for key_node, value_node in node.entries():
-            obj = self.declared(key_node, objects, "'initial'")
+            obj = self.declared(key_node, objects, "'initial'", _MOVABLE)
             if obj is not None and obj.kind is ObjectKind.OBSTACLE:
                 self.error(
                     key_node,
@@ -625,7 +643,7 @@ class ProblemBuilder(NodeReader):
         if not isinstance(node.value, str):
             self.error(node, f"expected the name of a declared part, got {describe(node.value)}")
             return None
-        obj = self.declared(node, objects, "'goal.relative.reference'")
+        obj = self.declared(node, objects, "'goal.relative.reference'", (ObjectKind.PART,))
         if obj is None:
             return None
         if obj.kind is None:
@@ -652,7 +670,7 @@ class ProblemBuilder(NodeReader):
         ok = True
         where = "'goal.relative.poses'" if node.path.endswith("relative.poses") else "the goal"
         for key_node, value_node in node.entries():
-            obj = self.declared(key_node, objects, where)
+            obj = self.declared(key_node, objects, where, (ObjectKind.PART,), reference)
             if obj is not None and obj.kind is not None and obj.kind is not ObjectKind.PART:
                 self.error(
                     key_node,

@@ -589,7 +589,7 @@ def test_refuses_an_initial_object_that_is_not_declared(tmp_path: Path) -> None:
         where(path, "Q:"),
         "initial.Q",
         "'Q' in 'initial' is not declared under 'objects'",
-        "expected one of the declared objects (A)",
+        "expected one of the declared parts, manipulators and fixtures (A)",
     )
 
 
