@@ -345,12 +345,39 @@ def run_child(
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--vertices", type=int, nargs="+", default=[1000, 20000])
-    parser.add_argument("--timeout", type=float, default=120.0)
-    parser.add_argument("--limit-gb", type=float, default=4.0)
+    parser.add_argument(
+        "--vertices",
+        type=int,
+        nargs="+",
+        default=[1000, 20000],
+        metavar="N",
+        help="vertex counts of the star-polygon problems to generate, one problem each "
+        "(without --files; default: 1000 20000)",
+    )
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=120.0,
+        help="seconds after which a child command is stopped (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--limit-gb",
+        type=float,
+        default=4.0,
+        help="address-space limit of each child command, in GiB (default: %(default)s)",
+    )
     parser.add_argument("--files", action="store_true", help="files up to 1 MB of every kind")
     parser.add_argument("--baseline", help="with --files: also check with the tree at this rev")
-    parser.add_argument("--kinds", nargs="+", choices=sorted(KINDS), default=list(KINDS))
+    parser.add_argument(
+        "--kinds",
+        nargs="+",
+        choices=sorted(KINDS),
+        default=list(KINDS),
+        metavar="KIND",
+        help="with --files: generate and check only these kinds of file, from: "
+        + ", ".join(sorted(KINDS))
+        + " (default: all)",
+    )
     options = parser.parse_args()
     limit = int(options.limit_gb * 2**30)
     if options.files:

@@ -37,11 +37,35 @@ PROBLEMS = ("blocks-2", "blocks-3", "blocks-4", "blocks-7")
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--examples", type=int, default=600)
-    parser.add_argument("--rollouts", type=int, default=200)
+    parser.add_argument(
+        "--examples",
+        type=int,
+        default=600,
+        help="training examples per model (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--rollouts",
+        type=int,
+        default=200,
+        help="simulated rollouts per training example (default: %(default)s)",
+    )
     parser.add_argument("--angles", default="15,25", help="comma-separated degrees")
-    parser.add_argument("--wall-push", default="planner", choices=("uniform", "wall", "planner"))
-    parser.add_argument("--output-dir", type=Path, default=Path("out/cbst-variants"))
+    parser.add_argument(
+        "--wall-push",
+        default="planner",
+        choices=("uniform", "wall", "planner"),
+        help="where the training pushes send the paddle's front: uniform between the "
+        "compressed train of blocks and the wall, wall at the wall, planner where CBST's push "
+        "to the wall does (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--output-dir",
+        type=Path,
+        default=Path("out/cbst-variants"),
+        metavar="DIR",
+        help="folder holding one subfolder per trained model; a model already there is "
+        "reused (default: %(default)s)",
+    )
     args = parser.parse_args()
     base = GenerationSettings()
     for angle in (float(a) for a in args.angles.split(",")):

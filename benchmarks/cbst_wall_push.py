@@ -129,12 +129,38 @@ def tilt() -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--examples", type=int, default=200)
-    parser.add_argument("--rollouts", type=int, default=100)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--controller", choices=("compliant", "servo"), default="compliant")
-    parser.add_argument("--rules", default="wall,uniform,planner")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--examples",
+        type=int,
+        default=200,
+        help="training examples (scenes) pushed under each rule (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--rollouts",
+        type=int,
+        default=100,
+        help="simulated rollouts per example (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the examples, the same for every rule (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--controller",
+        choices=("compliant", "servo"),
+        default="compliant",
+        help="controller driving the paddle in every rollout; --tilt runs both "
+        "(default: %(default)s)",
+    )
+    parser.add_argument(
+        "--rules",
+        default="wall,uniform,planner",
+        help="comma-separated push rules to measure, from wall, uniform and planner "
+        "(default: %(default)s)",
+    )
     parser.add_argument("--tilt", action="store_true", help="the tilt measurement instead")
     args = parser.parse_args()
     if args.tilt:

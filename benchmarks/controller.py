@@ -275,7 +275,13 @@ def main() -> None:
         help="also measure each gain with its set point fixed at the push's end (the set point "
         "speed 1e9 in/s: reached in the first step), the catapult the moving set point avoids",
     )
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the scenes' random draws (friction, densities, approach offsets), "
+        "the same for every controller (default: %(default)s)",
+    )
     parser.add_argument("--output", type=Path, default=None, help="CSV to write the rows to")
     args = parser.parse_args()
     gains = [float(v) for v in args.kp.split(",") if v]

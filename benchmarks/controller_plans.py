@@ -92,16 +92,36 @@ def follow_servo(name: str, kp: float | None) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problems", default="all")
-    parser.add_argument("--controllers", default="servo,compliant")
+    parser.add_argument(
+        "--problems",
+        default="all",
+        help="comma-separated shipped problem names, or all for every one (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--controllers",
+        default="servo,compliant",
+        help="comma-separated controller kinds (servo, compliant) to plan under "
+        "(default: %(default)s)",
+    )
     parser.add_argument("--kp", type=float, default=None, help="the compliant controller's gain")
     parser.add_argument("--particles", default="0", help="0 is the deterministic planner")
-    parser.add_argument("--particle-problems", default="blocks-4")
+    parser.add_argument(
+        "--particle-problems",
+        default="blocks-4",
+        help="comma-separated problems planned with the nonzero --particles counts "
+        "(default: %(default)s)",
+    )
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds per plan")
     parser.add_argument(
         "--max-nodes", type=int, default=None, help="node limit (default: each problem's own)"
     )
-    parser.add_argument("--output", type=Path, default=None)
+    parser.add_argument(
+        "--output",
+        type=Path,
+        default=None,
+        help="CSV file the rows are written to, each as soon as it is measured; overwritten; "
+        "unused with --follow-servo (default: none, print only)",
+    )
     parser.add_argument(
         "--follow-servo",
         action="store_true",

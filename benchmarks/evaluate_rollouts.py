@@ -65,13 +65,43 @@ def _plan(problem_name: str, max_nodes: int | None) -> Path:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problem", default="blocks-7")
+    parser.add_argument(
+        "--problem",
+        default="blocks-7",
+        help="shipped problem whose plan is evaluated; planned first unless --plan is given "
+        "(default: %(default)s)",
+    )
     parser.add_argument("--plan", default=None, help="plan file (default: plan it first)")
-    parser.add_argument("--rollouts", type=int, default=1000)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--max-nodes", type=int, default=None)
-    parser.add_argument("--no-dask", action="store_true")
+    parser.add_argument(
+        "--rollouts",
+        type=int,
+        default=1000,
+        help="rollouts evaluated on each backend (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the rollouts, the same on every backend (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        help="worker processes of the local pool and of the Dask cluster (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--max-nodes",
+        type=int,
+        default=None,
+        help="without --plan: node limit of the deterministic planning run "
+        "(default: the problem's own, else 5000)",
+    )
+    parser.add_argument(
+        "--no-dask",
+        action="store_true",
+        help="skip the Dask LocalCluster runs: measure local workers only",
+    )
     args = parser.parse_args()
 
     problem = load(args.problem)

@@ -101,11 +101,29 @@ def measure(
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problems", nargs="*", type=Path, default=None)
-    parser.add_argument("--particles", type=int, default=20)
+    parser.add_argument(
+        "--problems",
+        nargs="*",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="problem files to plan (default: every file of tests/problems/fresh/)",
+    )
+    parser.add_argument(
+        "--particles",
+        type=int,
+        default=20,
+        help="the planner's belief particles (default: %(default)s)",
+    )
     parser.add_argument("--semantics", default="particles", help="deterministic, particles, ...")
     parser.add_argument("--timeout", type=float, default=300.0, help="planning seconds")
-    parser.add_argument("--rollouts", type=int, default=200)
+    parser.add_argument(
+        "--rollouts",
+        type=int,
+        default=200,
+        help="noisy rollouts (seed 0) evaluating each plan found; 0 skips the evaluation "
+        "(default: %(default)s)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="the planner's seed")
     parser.add_argument(
         "--validate",
@@ -113,7 +131,13 @@ def main() -> None:
         default=None,
         help="the planner's validation rollouts (default: its own, twice the particles; 0 off)",
     )
-    parser.add_argument("--output", type=Path, default=None)
+    parser.add_argument(
+        "--output",
+        type=Path,
+        default=None,
+        help="CSV file each row is appended to as soon as it is measured (header written if "
+        "the file is new; default: none, print only)",
+    )
     args = parser.parse_args()
     paths = args.problems or sorted(FRESH.glob("*.yaml"))
     writer = None

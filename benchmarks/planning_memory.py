@@ -79,8 +79,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--blocks-7", action="store_true", help="also plan blocks-7 (minutes)")
     parser.add_argument("--holders", metavar="PROBLEM", help="tracemalloc on PROBLEM instead")
-    parser.add_argument("--timeout", type=float, default=3600.0)
-    parser.add_argument("--limit-gb", type=float, default=4.0)
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=3600.0,
+        help="seconds after which a planning child is stopped (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--limit-gb",
+        type=float,
+        default=4.0,
+        help="address-space limit of each planning child, in GiB (default: %(default)s)",
+    )
     options = parser.parse_args()
     if options.holders:
         _holders(options.holders, 15)

@@ -467,18 +467,83 @@ def success_counts(n: int, seed: int, new: PhysicsSettings) -> None:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--controller", default="compliant,servo")
-    parser.add_argument("--draws", type=int, default=3)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--new", nargs="*", metavar="KEY=VALUE", default=None)
-    parser.add_argument("--alternatives", action="store_true")
+    parser.add_argument(
+        "--controller",
+        default="compliant,servo",
+        help="comma-separated controller kinds (compliant, servo) whose push catalogue is "
+        "measured (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--draws",
+        type=int,
+        default=3,
+        help="noise draws (friction, densities, approach offset) per push (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the noise draws, and of the --evaluate rollouts (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--new",
+        nargs="*",
+        metavar="KEY=VALUE",
+        default=None,
+        help="PhysicsSettings fields overriding the new settings' defaults, e.g. dt=1/480 "
+        "iterations=20 (numbers, fractions, true or false; default: none)",
+    )
+    parser.add_argument(
+        "--alternatives",
+        action="store_true",
+        help="instead of old and new, summarise each alternative physics setting of the "
+        "script's ALTERNATIVES (the table of docs/design/physics.md)",
+    )
     parser.add_argument("--repeat", type=int, default=3, help="timed runs per push (least)")
-    parser.add_argument("--csv", default=None)
-    parser.add_argument("--rollouts", type=int, default=None)
-    parser.add_argument("--rounds", type=int, default=4)
-    parser.add_argument("--particle-plan", default=None)
-    parser.add_argument("--evaluate", type=int, default=None, metavar="N")
-    parser.add_argument("--saturation", action="store_true")
+    parser.add_argument(
+        "--csv",
+        default=None,
+        metavar="FILE",
+        help="CSV file to write one row per push and setting to, overwritten "
+        "(default: none, print only)",
+    )
+    parser.add_argument(
+        "--rollouts",
+        type=int,
+        default=None,
+        metavar="N",
+        help="instead, measure rollouts per second of the blocks-7 plans under old and new "
+        "settings, N rollouts per setting and plan, rounded down to a multiple of --rounds "
+        "(default: off)",
+    )
+    parser.add_argument(
+        "--rounds",
+        type=int,
+        default=4,
+        help="with --rollouts: alternating old/new rounds the rollouts are split into "
+        "(default: %(default)s)",
+    )
+    parser.add_argument(
+        "--particle-plan",
+        default=None,
+        metavar="FILE",
+        help="with --rollouts or --saturation: plan file of the compliant particle plan of "
+        "blocks-7 (default: plan it, 25 particles, seed 0)",
+    )
+    parser.add_argument(
+        "--evaluate",
+        type=int,
+        default=None,
+        metavar="N",
+        help="instead, print the successes of the compliant goldens' plans in N rollouts "
+        "under old and new settings (default: off)",
+    )
+    parser.add_argument(
+        "--saturation",
+        action="store_true",
+        help="instead, count the steps of compliant pushes during which the force was clipped "
+        "while the set point still moved",
+    )
     args = parser.parse_args()
     if args.saturation:
         saturation(args.particle_plan)
