@@ -18,15 +18,13 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from arrange_up.belief.goals import PartMiss
 from arrange_up.belief.states import ParticleBelief
-from arrange_up.geometry.shapes import footprint
 from arrange_up.io.planfile import plan_document
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
 from arrange_up.parallel import Runner, SerialRunner, check_runner_options, get_runner
+from arrange_up.planning.fitting import too_large, unfit_parts
 from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
 from arrange_up.planning.validation import (
@@ -135,7 +133,9 @@ class PlanResult:
     ``statistics`` holds the search statistics; :attr:`stats` is their JSON form.
     ``misses`` (None when solved) says how the belief of the smallest heuristic value the search
     reached still misses the goal (per part, the dimensions some particle is out of tolerance
-    in); for ``unsolvable``, the parts that cannot fit on the table (``off table``).
+    in); for ``unsolvable``, the parts that cannot fit on the table (``off table``), and
+    ``unfit`` why each of them cannot (:func:`~arrange_up.planning.fitting.unfit_parts`: at no
+    angle, or no pose, its goal allows), one clause each, in the problem's display units.
     ``refusals``: ``(reason, count)`` of the candidates the semantics refused, most frequent
     first, for a semantics that says why (CBST's ``reasons``; empty otherwise).
     ``unplaceable`` (empty when solved): the parts off the table that have a place target at the
@@ -160,6 +160,7 @@ class PlanResult:
     refusals: tuple[tuple[str, int], ...] = ()
     validation: Validation | None = None
     unplaceable: tuple[str, ...] = ()
+    unfit: tuple[str, ...] = ()
 
     @property
     def solved(self) -> bool:
@@ -175,6 +176,8 @@ class PlanResult:
             return None
         s = self.statistics
         if self.status == SearchStatus.UNSOLVABLE:
+            if self.unfit:
+                return "; ".join(self.unfit) + ": no plan exists"
             parts = ", ".join(m.part for m in self.misses or ())
             return f"{parts} cannot fit on the table in any orientation: no plan exists"
         nodes = f"{s.expanded} node{'s' if s.expanded != 1 else ''}"
@@ -517,7 +520,8 @@ def _search(
         if progress is not None:
             progress(SearchSnapshot.of(stats, evaluator.simulations).to_json())
 
-    oversized = too_large(problem)
+    unfit = unfit_parts(problem)
+    oversized = tuple(u.part for u in unfit)
     try:
         start_belief = task.initial_belief()
         # A goal part that cannot fit on the table is a proof: no search is needed.
@@ -566,6 +570,7 @@ def _search(
         misses=misses,
         refusals=tuple(getattr(task.semantics, "reasons", Counter()).most_common()),
         unplaceable=_unplaceable(task, start_belief, misses),
+        unfit=tuple(u.why for u in unfit),
     )
 
 
@@ -601,31 +606,3 @@ def _unplaceable(
         and name not in placed
         and task.generator.place_target(name, intervals) is not None
     )
-
-
-def too_large(problem: ArrangementProblem) -> tuple[str, ...]:
-    """The goal parts that cannot lie on the table in any orientation: a proof that no plan
-    exists, since every goal part must be on the table.
-
-    A part fits at some orientation only if its extent across that orientation's y axis is at
-    most the table's smaller side; its smallest extent over all directions (the width of its
-    convex hull, reached across one of the hull's edges) exceeding that side rules out every
-    orientation.
-    """
-    side = min(problem.table.width, problem.table.depth)
-    found = []
-    for name in problem.goal.parts:
-        shape = problem.object(name).shape
-        if shape is None:
-            continue
-        hull = footprint(shape.parts, (0.0, 0.0, 0.0)).convex_hull
-        points = np.asarray(hull.exterior.coords, dtype=float)[:-1]
-        if len(points) < 3:
-            continue
-        edges = np.roll(points, -1, axis=0) - points
-        normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)
-        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-        spans = points @ normals.T  # (vertex, edge direction)
-        if float((spans.max(axis=0) - spans.min(axis=0)).min()) > side + 1e-9:
-            found.append(name)
-    return tuple(found)

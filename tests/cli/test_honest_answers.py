@@ -211,6 +211,6 @@ def test_a_goal_part_larger_than_the_table_is_unsolvable(tmp_path):
     shown = run("plan", str(path), "--semantics", "deterministic")
     assert shown.exit_code == 1
     assert "big: unsolvable (deterministic" in shown.output
-    assert "A cannot fit on the table in any orientation: no plan exists" in shown.output
+    assert "part A (4 x 3 in) fits the 3 x 2 in table at no angle: no plan exists" in shown.output
     summary = json.loads(run("plan", str(path), "--semantics", "deterministic", "--json").stdout)
     assert summary["status"] == "unsolvable" and summary["plan_length"] is None

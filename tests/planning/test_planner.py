@@ -279,10 +279,16 @@ def test_a_goal_part_larger_than_the_table_is_proven_unsolvable_before_searching
         result = plan(problem, semantics=semantics, particles=5, workers=1)
         assert result.status is SearchStatus.UNSOLVABLE and result.actions is None
         assert result.stats["expanded"] == 0 and result.stats["transitions_simulated"] == 0
-        assert result.reason == "A cannot fit on the table in any orientation: no plan exists"
-    # Only the smallest width counts: turned a quarter, the part fits a 3 x 4 in table.
-    fits, _ = check_problem_text(TOO_LARGE.replace("[3, 2]", "[3, 4]"), "fits")
+        assert (
+            result.reason == "part A (4 x 3 in) fits the 3 x 2 in table at no angle: no plan exists"
+        )
+    # Turned a quarter, the part fits a 3 x 4 in table: a goal turned so is left to the search,
+    # but the walls keep it from lying at the 0 +- 15 degrees of TOO_LARGE's goal.
+    taller = TOO_LARGE.replace("[3, 2]", "[3, 4]")
+    fits, _ = check_problem_text(taller.replace("[1.5, 1, 0]", "[1.5, 2, 90]"), "fits")
     assert fits is not None and too_large(fits) == ()
+    unturned, _ = check_problem_text(taller, "unturned")
+    assert unturned is not None and too_large(unturned) == ("A",)
     assert too_large(tiny("obstacle")) == ()
 
 

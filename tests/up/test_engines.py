@@ -374,7 +374,7 @@ def test_an_exhausted_search_is_incomplete_and_a_too_large_part_proven_unsolvabl
     proven = _solve(to_up(big))
     assert proven.status is Status.UNSOLVABLE_PROVEN and proven.plan is None
     assert proven.log_messages[0].message == (
-        "A cannot fit on the table in any orientation: no plan exists"
+        "part A (4 x 3 in) fits the 3 x 2 in table at no angle: no plan exists"
     )
 
 
