@@ -10,7 +10,9 @@ since every extra inch must be pushed and pushing accrues uncertainty. The angle
 target's (``planning.place_angles`` adds alternatives). For a relative goal the target is the
 goal pose composed with the reference part's current belief centre; the reference itself, when
 it starts off the table, is placed about :attr:`~arrange_up.planning.mating.Mates.home` (its
-goal is anywhere: there, the goal arrangement is centred on the table).
+goal is anywhere: there, the goal arrangement is centred on the table), or, where no place there
+is clear, about the first of the other :attr:`~arrange_up.planning.mating.Mates.homes` that has
+a clear place.
 
 **Push** (Figure 2-11): "object-centric" pushes. For every part on the table and every axis
 direction (``planning.push_directions`` restricts them), the manipulator is put behind the
@@ -333,6 +335,15 @@ class ActionGenerator:
             rt + target[2],
         )
 
+    def _place_targets(self, name: str, belief: IntervalBelief) -> tuple[Pose, ...]:
+        """The poses about which ``name`` is placed, to be tried in order: its
+        :meth:`place_target`, or for a relative goal's reference off the table every one of
+        :attr:`Mates.homes` (the first with a clear place is used)."""
+        if name == self.problem.goal.reference and name not in belief:
+            return self.mates.homes
+        target = self.place_target(name, belief)
+        return () if target is None else (target,)
+
     def places(self, belief: IntervalBelief, only: str | None = None) -> list[Place]:
         """Place candidates of every goal part off the table (or of ``only``)."""
         on_table = self._shadows(belief)
@@ -341,35 +352,37 @@ class ActionGenerator:
         for spec in self.problem.parts:
             if spec.name in belief or (only is not None and spec.name != only):
                 continue
-            target = self.place_target(spec.name, belief)
-            if target is None:
-                continue
-            angles = self._place_angles(target)
-            for dx, dy in self.offsets[spec.name]:
-                for theta in angles:
-                    pose = (target[0] + dx, target[1] + dy, theta)
-                    if boxes is None:
-                        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
-                    if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
-                        actions.append(Place(spec.name, _clean(pose)))
+            for target in self._place_targets(spec.name, belief):
+                found = len(actions)
+                angles = self._place_angles(target)
+                for dx, dy in self.offsets[spec.name]:
+                    for theta in angles:
+                        pose = (target[0] + dx, target[1] + dy, theta)
+                        if boxes is None:
+                            boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+                        if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
+                            actions.append(Place(spec.name, _clean(pose)))
+                if len(actions) > found:
+                    break
         return actions
 
     def place_poses(self, belief: IntervalBelief, name: str) -> list[Pose]:
         """Candidate place poses of ``name`` that fit the table, walls and obstacles, whatever
-        the objects on the table (those are the precondition's other half)."""
-        target = self.place_target(name, belief)
-        if target is None:
-            return []
-        poses = []
-        angles = self._place_angles(target)
-        for dx, dy in self.offsets[name]:
-            for theta in angles:
-                pose = (target[0] + dx, target[1] + dy, theta)
-                if self.checker.shadow_inside_table(
-                    name, pose, self.place_unc
-                ) and not self.checker.shadow_hits_fixed(name, pose, self.place_unc):
-                    poses.append(pose)
-        return poses
+        the objects on the table (those are the precondition's other half); for a relative
+        goal's reference, about the first of :attr:`Mates.homes` that has any."""
+        for target in self._place_targets(name, belief):
+            poses = []
+            angles = self._place_angles(target)
+            for dx, dy in self.offsets[name]:
+                for theta in angles:
+                    pose = (target[0] + dx, target[1] + dy, theta)
+                    if self.checker.shadow_inside_table(
+                        name, pose, self.place_unc
+                    ) and not self.checker.shadow_hits_fixed(name, pose, self.place_unc):
+                        poses.append(pose)
+            if poses:
+                return poses
+        return []
 
     def _place_angles(self, target: Pose) -> tuple[float, ...]:
         """The target's angle, then each ``planning.place_angles`` offset from it, once each."""

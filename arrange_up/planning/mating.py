@@ -44,7 +44,13 @@ the generator presses it against the wall ahead, centred and as a turning push o
 Fourth, where to put the reference down when it starts off the table (:attr:`Mates.home`): its
 goal lets it end anywhere, so the goal gives no place; it is placed (with the usual grid of
 offsets) where the goal arrangement, the reference and its mates at their targets, is centred
-on the table, which leaves the most room around it for the mates' places and pushes.
+on the table, which leaves the most room around it for the mates' places and pushes. Where
+none of those places is clear (an obstacle in the middle of the table, or a part there), the
+generator tries :attr:`Mates.homes` after it, in order: a deterministic set of other poses
+(at most ``MAX_HOMES - 1``) from a ``HOME_GRID`` x ``HOME_GRID`` grid over the table at which
+the whole arrangement, grown by the reference's place noise plus ``HOME_MARGIN``, stays on the
+table and clear of every obstacle, nearest the centre first. The first of them with a clear
+place is used, so wherever the centre has one nothing changes.
 
 Nothing of this is offered for an absolute goal, whose parts are seated against walls, fences
 and the trains of parts ahead of them instead.
@@ -56,12 +62,19 @@ import math
 from functools import lru_cache
 
 import shapely
+import shapely.affinity
 
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem, Pose
 
 #: How far (in) a part's goal footprint is moved along a push to test whether its mate is ahead.
 CONTACT_PROBE = 0.05
+#: The side of the grid of alternative homes (:attr:`Mates.homes`), and how many homes at most.
+HOME_GRID = 5
+MAX_HOMES = 9
+#: Room (in) kept between the arrangement at an alternative home and the table's edges and the
+#: obstacles, beyond the reference's place noise.
+HOME_MARGIN = 0.1
 #: Overlap area (square inches) the probe must add for the mate to count as ahead: a contact
 #: face of 0.02 in or more (a corner touching only grazes, and a float's worth is noise).
 PROBE_AREA = 1e-3
@@ -88,6 +101,8 @@ class Mates:
         self._ahead = lru_cache(maxsize=50_000)(self._ahead_uncached)
         #: Where the reference is placed when it starts off the table (:meth:`_home`).
         self.home = self._home(problem) if goal.reference is not None else None
+        #: :attr:`home`, then the alternatives tried where it has no clear place (:meth:`_homes`).
+        self.homes: tuple[Pose, ...] = self._homes(problem) if self.home is not None else ()
 
     def __bool__(self) -> bool:
         return self.reference is not None
@@ -136,6 +151,52 @@ class Mates:
         x0, y0, x1, y1 = shapely.union_all(shapes).bounds
         width, depth = problem.table.size
         return (0.5 * width - 0.5 * (x0 + x1), 0.5 * depth - 0.5 * (y0 + y1), 0.0)
+
+    def _arrangement(self, problem: ArrangementProblem):
+        """The goal arrangement's nominal footprint with the reference at the origin, angle 0."""
+        shapes = [footprint(self._parts[self.reference], (0.0, 0.0, 0.0))]
+        shapes += [
+            footprint(self._parts[name], pose)
+            for name, pose in problem.goal.targets
+            if name != self.reference
+        ]
+        return shapely.union_all(shapes)
+
+    def _homes(self, problem: ArrangementProblem) -> tuple[Pose, ...]:
+        """:attr:`home`, then up to ``MAX_HOMES - 1`` other poses of the reference (angle 0)
+        from a ``HOME_GRID`` x ``HOME_GRID`` grid spanning the positions that keep the
+        arrangement on the table, at which the arrangement grown by the reference's place
+        noise plus ``HOME_MARGIN`` stays on the table and clear of the obstacles; nearest
+        :attr:`home` first (ties: lower y, then lower x). Deterministic: the same problem
+        gives the same homes."""
+        assert self.home is not None
+        dx, dy, dtheta = problem.uncertainty.place
+        radius = max(math.hypot(x, y) for part in self._parts[self.reference] for x, y in part)
+        margin = max(dx, dy) + radius * math.sin(min(dtheta, 0.5 * math.pi)) + HOME_MARGIN
+        grown = self._arrangement(problem).buffer(margin)
+        x0, y0, x1, y1 = grown.bounds
+        width, depth = problem.table.size
+        if x1 - x0 > width or y1 - y0 > depth:
+            return (self.home,)
+        obstacles = [
+            footprint(spec.shape.parts, spec.pose)
+            for spec in problem.obstacles
+            if spec.pose is not None
+        ]
+        hx, hy, _ = self.home
+        found = []
+        for j in range(HOME_GRID):
+            for i in range(HOME_GRID):
+                x = -x0 + (width - (x1 - x0)) * i / (HOME_GRID - 1)
+                y = -y0 + (depth - (y1 - y0)) * j / (HOME_GRID - 1)
+                if math.hypot(x - hx, y - hy) < 1e-9:
+                    continue
+                moved = shapely.affinity.translate(grown, x, y)
+                if any(moved.intersects(obstacle) for obstacle in obstacles):
+                    continue
+                found.append((round(math.hypot(x - hx, y - hy), 9), y, x))
+        found.sort()
+        return (self.home, *((x, y, 0.0) for _, y, x in found[: MAX_HOMES - 1]))
 
     def _ahead_uncached(self, name, target, mate, axis, sign) -> bool:
         other = footprint(self._parts[self.reference], mate)
