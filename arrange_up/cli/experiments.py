@@ -98,20 +98,37 @@ def _say(message: str) -> None:
 
 class _Measurements:
     """Progress per measurement: ``say`` a stage, ``done`` a finished measurement (counted, with
-    the elapsed time and, from the pace so far, the time left)."""
+    the elapsed time and, from the pace so far, the time left). ``opening`` (the duration
+    estimate) is printed before the first of them: the experiment reports its first stage only
+    after it has accepted its CSV, so a CSV it refuses is not preceded by an estimate of work
+    that will not be done."""
 
-    def __init__(self, display: Any, total: int) -> None:
+    def __init__(self, display: Any, total: int, opening: str) -> None:
         self.display, self.total, self.count = display, total, 0
+        self.opening: str | None = opening
         self.started = time.perf_counter()
         self.task = display.add_task("starting", total=total) if display is not None else None
 
+    def _open(self) -> None:
+        if self.opening is None:
+            return
+        if self.display is None:
+            _say(self.opening)
+        else:
+            self.display.console.print(
+                f"[{time.strftime('%H:%M:%S')}] {self.opening}", highlight=False
+            )
+        self.opening = None
+
     def say(self, message: str) -> None:
+        self._open()
         if self.display is None:
             _say(message)
         else:
             self.display.update(self.task, description=message)
 
     def done(self, line: str) -> None:
+        self._open()
         self.count += 1
         elapsed = time.perf_counter() - self.started
         left = elapsed / self.count * max(0, self.total - self.count)
@@ -127,9 +144,8 @@ class _Measurements:
 
 @contextmanager
 def _measurements(estimate: costs.Estimate, total: int) -> Iterator[_Measurements]:
-    """Print the duration estimate, then report each measurement (the CLI's progress
-    display on a terminal, lines on stderr otherwise)."""
-    _say(f"estimate: {estimate.describe(total)}")
+    """Report each measurement (the CLI's progress display on a terminal, lines on stderr
+    otherwise), after the duration estimate."""
     columns = (
         TextColumn("{task.description}"),
         BarColumn(),
@@ -137,7 +153,7 @@ def _measurements(estimate: costs.Estimate, total: int) -> Iterator[_Measurement
         TimeElapsedColumn(),
     )
     with terminal_progress(*columns) as display:
-        yield _Measurements(display, total)
+        yield _Measurements(display, total, f"estimate: {estimate.describe(total)}")
 
 
 def _transition_line(row: dict[str, Any]) -> str:

@@ -162,3 +162,5 @@ def test_a_rerun_with_a_cut_off_line_resumes_and_other_settings_exit_2(tmp_path:
     )
     assert result.exit_code == 2, result.output
     assert "other settings" in result.output and "rollouts" in result.output
+    # refused before any work: no estimate of work that will not be done
+    assert "estimate:" not in result.output
