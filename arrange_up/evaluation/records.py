@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from arrange_up.evaluation.outcomes import FAILURE_KINDS, GOAL_MISSED, RolloutRecord
-from arrange_up.io.files import lock_exclusively, recorded_lines
+from arrange_up.io.files import lock_exclusively, numbered_records, recorded_lines
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Pick, Place, Push
 
@@ -191,11 +191,9 @@ class RecordFile:
                 f"{self.path}: the record file belongs to another evaluation ({details}); its "
                 "rollouts cannot be mixed with this one's: use another record file or delete it"
             )
-        records: dict[int, RolloutRecord] = {}
         actions = _dig(header, ("plan", "actions"))
-        for number, line in enumerate(lines[1:], start=2):
-            if not line.strip():
-                continue
+
+        def parse(line: bytes, number: int) -> RolloutRecord:
             try:
                 data = json.loads(line)
                 problem = _record_problem(data, actions)
@@ -208,14 +206,11 @@ class RecordFile:
                     "the file was edited or written by something else: use another record file "
                     "or delete it"
                 ) from None
-            earlier = records.get(record.index)
-            if earlier is not None and earlier != record:
-                raise RecordFileError(
-                    f"{self.path}:{number}: rollout {record.index} is recorded twice with "
-                    "different outcomes"
-                )
-            records[record.index] = record
-        return records
+            return record
+
+        return numbered_records(
+            lines, self.path, parse, lambda r: r.index, "rollout", RecordFileError
+        )
 
     def write_line(self, data: dict) -> None:
         self.handle.write(json.dumps(data, separators=(",", ":")).encode("utf-8") + b"\n")

@@ -34,7 +34,7 @@ from arrange_up.execution.belief import ModelFailure
 from arrange_up.execution.executor import SimulatedExecutor
 from arrange_up.execution.observations import Sensor
 from arrange_up.execution.replanning import ClosedLoop, ClosedLoopSettings, LoopOutcome, Replan
-from arrange_up.io.files import lock_exclusively, recorded_lines
+from arrange_up.io.files import lock_exclusively, numbered_records, recorded_lines
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action
 
@@ -237,37 +237,29 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
             handle, path, EPISODES_FORMAT, "an arrange-up episode record", RecordFileError
         )
         lines = [line for line in lines if line.strip()]
+        if not lines:
+            handle.write(json.dumps(header).encode() + b"\n")
+            handle.flush()
+            return handle, {}
+        if json.loads(lines[0]) != json.loads(json.dumps(header)):
+            raise RecordFileError(
+                f"{path}: the record file belongs to another closed-loop run (its header "
+                "differs in the problem, plan, seed, sense, noise scale or settings); use "
+                "another file"
+            )
+
+        def parse(line: bytes, number: int) -> EpisodeRecord:
+            try:
+                return EpisodeRecord.from_json(json.loads(line))
+            except (ValueError, KeyError, TypeError) as error:
+                raise RecordFileError(f"{path}:{number}: not an episode record: {error}") from None
+
+        episodes = numbered_records(
+            lines, path, parse, lambda r: r.episode, "episode", RecordFileError
+        )
     except RecordFileError:
         handle.close()
         raise
-    episodes: dict[int, EpisodeRecord] = {}
-    if not lines:
-        handle.write(json.dumps(header).encode() + b"\n")
-        handle.flush()
-        return handle, episodes
-    found = json.loads(lines[0])
-    if found != json.loads(json.dumps(header)):
-        handle.close()
-        raise RecordFileError(
-            f"{path}: the record file belongs to another closed-loop run (its header differs "
-            "in the problem, plan, seed, sense, noise scale or settings); use another file"
-        )
-    for number, line in enumerate(lines[1:], start=2):
-        try:
-            record = EpisodeRecord.from_json(json.loads(line))
-        except (ValueError, KeyError, TypeError) as error:
-            handle.close()
-            raise RecordFileError(f"{path}:{number}: not an episode record: {error}") from None
-        earlier = episodes.get(record.episode)
-        if earlier is not None and earlier != record:
-            # as the evaluation's records: a conflicting copy would change the count silently
-            handle.close()
-            raise RecordFileError(
-                f"{path}:{number}: episode {record.episode} is recorded twice with different "
-                "outcomes; the file was edited or written by something else: use another "
-                "record file or delete it"
-            )
-        episodes[record.episode] = record
     return handle, episodes
 
 

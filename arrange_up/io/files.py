@@ -1,19 +1,29 @@
 """Small file helpers shared by the readers and the resumable result files: where a file stops
 being UTF-8, an exclusive lock that refuses a second writer, and the complete lines of a
-``.jsonl`` record (a line cut off by a kill dropped, a file of another kind refused)."""
+``.jsonl`` record (a line cut off by a kill dropped, a file of another kind refused) and its
+records by number (one recorded twice with different outcomes refused)."""
 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import IO
+from typing import IO, TypeVar
 
 try:
     import fcntl
 except ImportError:  # pragma: no cover - not on POSIX: files are not locked
     fcntl = None
 
-__all__ = ["lock_exclusively", "recorded_lines", "text_place", "undecodable_place"]
+__all__ = [
+    "lock_exclusively",
+    "numbered_records",
+    "recorded_lines",
+    "text_place",
+    "undecodable_place",
+]
+
+R = TypeVar("R")
 
 
 def text_place(text: str | bytes, index: int) -> tuple[int, int]:
@@ -79,6 +89,37 @@ def recorded_lines(
     if cut:
         handle.truncate(len(data) - len(cut))
     return complete
+
+
+def numbered_records(
+    lines: Sequence[bytes],
+    path: Path,
+    parse: Callable[[bytes, int], R],
+    number_of: Callable[[R], int],
+    noun: str,
+    error: type[Exception] = ValueError,
+) -> dict[int, R]:
+    """The records of :func:`recorded_lines` ``lines`` after the header (blank lines skipped),
+    by their number (``number_of``: a rollout's index, an episode's number). ``parse(line,
+    line_number)`` reads one line and raises the caller's error for one it cannot. A number
+    recorded twice with different outcomes raises ``error`` at the second copy's line (``noun``
+    names what is numbered): the last copy winning would change a count silently; the same
+    record twice is harmless and read once."""
+    records: dict[int, R] = {}
+    for line_number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        record = parse(line, line_number)
+        number = number_of(record)
+        earlier = records.get(number)
+        if earlier is not None and earlier != record:
+            raise error(
+                f"{path}:{line_number}: {noun} {number} is recorded twice with different "
+                "outcomes; the file was edited or written by something else: use another "
+                "record file or delete it"
+            )
+        records[number] = record
+    return records
 
 
 def _cut_header(cut: bytes, record_format: str) -> bool:

@@ -116,3 +116,14 @@ def test_a_resumed_evaluation_refuses_an_edited_line(tmp_path: Path):
     record.write_text("\n".join(lines) + "\n")  # as written: resumed, identical
     again = evaluate_plan(problem, actions, rollouts=3, seed=0, workers=1, record=record)
     assert again == first and again.resumed == 3
+
+
+def test_a_rollout_recorded_twice_is_read_once_or_refused_when_the_copies_differ(tmp_path):
+    path = tmp_path / "r.jsonl"
+    _write(path, *GOOD, GOOD[0])  # the same line again (a copy): harmless
+    file = RecordFile(path, HEADER)
+    file.close()
+    assert sorted(file.records) == [0, 1, 2]
+    _write(path, *GOOD, {"rollout": 1, "success": True})  # another outcome: refused
+    with pytest.raises(RecordFileError, match=r":5: rollout 1 is recorded twice with different"):
+        RecordFile(path, HEADER)
