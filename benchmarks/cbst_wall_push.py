@@ -32,7 +32,10 @@ and 15°, the paddle centred on it or 0.5 in to either side, friction 0.25, 0.4 
 (densities at the middle of their ranges), pushed by the ``planner`` rule (no pose
 uncertainty) and with its set point 1 in past the compressed block, under each controller.
 Printed: the largest and mean final ``|θ|`` of the block (in its 90° period) and the largest
-final ``|θ|`` of the paddle from its commanded angle (deg).
+final ``|θ|`` of the paddle from its commanded angle (deg). ``--wrist 1,4,16`` adds compliant
+controllers whose wrist is that many times stiffer and stronger than the default (``kp_angle``
+and the torque clip both scaled: ``Kp r^2`` and ``force r`` are the defaults, ``r`` the
+paddle's radius), to measure how much of the tilt the wrist's compliance is.
 """
 
 from __future__ import annotations
@@ -54,7 +57,9 @@ from arrange_up.cbst.data import (
     generate_example,
 )
 from arrange_up.cbst.features import BUCKLE_LIMIT
+from arrange_up.model.problem import Controller
 from arrange_up.model.world import ActionNoise, Push, WorldState
+from arrange_up.physics.settings import push_force
 from arrange_up.physics.simulation import simulate
 from arrange_up.physics.stall import wall_overdrive
 
@@ -94,9 +99,25 @@ def measure(rule: str, examples: int, rollouts: int, seed: int, controller) -> d
     }
 
 
-def tilt() -> None:
-    """The ``--tilt`` measurement (module docstring)."""
-    for name, controller in (("compliant", COMPLIANT), ("servo", SERVO)):
+def stiff_wrist(scale: float) -> Controller:
+    """The default compliant controller with its wrist ``scale`` times as stiff and as strong
+    (``kp_angle`` and the torque clip at ``scale`` times their defaults in the CBST scene)."""
+    problem = _scene(DEFAULT_GENERATION)
+    paddle = problem.object("paddle").shape
+    radius = max(math.hypot(x, y) for part in paddle.parts for x, y in part)
+    kp = COMPLIANT.kp
+    return replace(
+        COMPLIANT,
+        kp_angle=scale * kp * radius * radius,
+        torque=scale * push_force(problem) * radius,
+    )
+
+
+def tilt(wrists: tuple[float, ...] = ()) -> None:
+    """The ``--tilt`` measurement (module docstring), with the stiffer wrists ``wrists``."""
+    controllers = [("compliant", COMPLIANT), ("servo", SERVO)]
+    controllers += [(f"wrist x{w:g}", stiff_wrist(w)) for w in wrists]
+    for name, controller in controllers:
         settings = replace(DEFAULT_GENERATION, controller=controller)
         problem = _scene(settings)
         d = settings.block_size
@@ -162,9 +183,16 @@ def main() -> None:
         "(default: %(default)s)",
     )
     parser.add_argument("--tilt", action="store_true", help="the tilt measurement instead")
+    parser.add_argument(
+        "--wrist",
+        default="",
+        metavar="SCALES",
+        help="with --tilt: comma-separated multiples of the compliant wrist's default "
+        "stiffness and torque clip to measure as well (default: none)",
+    )
     args = parser.parse_args()
     if args.tilt:
-        tilt()
+        tilt(tuple(float(w) for w in args.wrist.split(",") if w))
         return
     controller = COMPLIANT if args.controller == "compliant" else SERVO
     print(
