@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.evaluation.rollouts import rollout_start
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
@@ -105,11 +106,6 @@ class ValidationRound:
     successes: int | None
     run: int | None = None
 
-    @property
-    def rate(self) -> float:
-        """Successes per validation rollout run (0 when none ran or there is no plan)."""
-        return self.successes / self.run if self.successes is not None and self.run else 0.0
-
     def to_json(self) -> dict[str, Any]:
         return {
             "particles": self.particles,
@@ -122,11 +118,17 @@ class ValidationRound:
 
 def choose_round(rounds: tuple[ValidationRound, ...]) -> int:
     """The index of the round whose plan a validated run returns: among the rounds with a plan,
-    the highest success rate on the rollouts run, then the most rollouts run, then the later
-    (it was searched with more particles). When every round ran its rollouts in full this is
-    the most successes, the later on a tie."""
+    the highest lower end of the 95 % Wilson interval of its successes on the rollouts run
+    (so a round cut short after a few lucky rollouts does not beat one that ran them all),
+    then the most rollouts run, then the later (it was searched with more particles). When
+    every round ran its rollouts in full this is the most successes, the later on a tie."""
     planned = [i for i, r in enumerate(rounds) if r.successes is not None]
-    return max(planned, key=lambda i: (rounds[i].rate, rounds[i].run or 0, i))
+
+    def key(i: int) -> tuple[float, int, int]:
+        run, successes = rounds[i].run or 0, rounds[i].successes or 0
+        return (wilson_interval(successes, run)[0] if run else 0.0, run, i)
+
+    return max(planned, key=key)
 
 
 @dataclass(frozen=True)

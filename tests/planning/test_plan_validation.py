@@ -191,12 +191,14 @@ def test_a_stop_request_keeps_the_plan_and_the_rollouts_already_run(narrow, monk
     assert "validated on 4 of 10 fresh rollouts (stopped by a stop request)" in validation.line()
 
 
-def test_the_round_returned_is_the_best_rate_on_the_rollouts_run() -> None:
-    rounds = (
-        ValidationRound(2, "solved", 5, 8, 10),
-        ValidationRound(4, "solved", 5, 3, 3),  # cut short, but all of its rollouts succeeded
-        ValidationRound(6, "timeout", 5, None),
-    )
-    assert choose_round(rounds) == 1
+def test_the_round_returned_is_the_surest_on_the_rollouts_run() -> None:
+    complete = ValidationRound(2, "solved", 5, 8, 10)
+    lucky = ValidationRound(4, "solved", 5, 3, 3)  # cut short after three successes
+    surer = ValidationRound(4, "solved", 5, 30, 30)  # cut short after thirty
+    no_plan = ValidationRound(6, "timeout", 5, None)
+    # by the Wilson interval's lower end: 3/3 (0.44) does not beat 8/10 (0.49); 30/30 does
+    assert choose_round((complete, lucky, no_plan)) == 0
+    assert choose_round((complete, surer, no_plan)) == 1
     # complete rounds: the most successes, the later on a tie
-    assert choose_round((rounds[0], ValidationRound(4, "solved", 5, 8, 10))) == 1
+    assert choose_round((complete, ValidationRound(4, "solved", 5, 8, 10))) == 1
+    assert choose_round((complete, ValidationRound(4, "solved", 5, 7, 10))) == 0
