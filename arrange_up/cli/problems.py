@@ -18,6 +18,7 @@ from arrange_up.io.files import text_place
 from arrange_up.io.pddl import PddlExportError, write_pddl_problem
 from arrange_up.io.pddl_reader import problem_name_place
 from arrange_up.io.planfile import write_text_atomic
+from arrange_up.model.problem import ArrangementProblem
 
 
 @click.command()
@@ -81,6 +82,7 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
             failed += 1
             continue
         names.setdefault(key, path)
+        _warn_unfit(shown, problem)
         if not quiet:
             click.echo(
                 f"{shown}: ok: {problem.name} ({len(problem.parts)} "
@@ -89,6 +91,21 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
             )
     if failed:
         fail(f"{failed} of {len(files)} file(s) failed", EXIT_NEGATIVE)
+
+
+def _warn_unfit(shown: str, problem: ArrangementProblem) -> None:
+    """Warn of each goal part that the planner proves cannot fit the table at any pose its
+    goal allows (:func:`arrange_up.planning.fitting.unfit_parts`): the file is valid, but no
+    plan exists, and ``plan`` answers ``unsolvable``."""
+    # Lazy: the proof needs numpy and shapely, which a check of a broken file never does.
+    from arrange_up.planning.fitting import unfit_parts
+
+    for unfit in unfit_parts(problem):
+        where = "goal.relative" if problem.goal.is_relative else f"goal.poses.{unfit.part}"
+        click.echo(
+            f"{shown}: warning: {where}: {unfit.why}: no plan exists (plan answers unsolvable)",
+            err=True,
+        )
 
 
 @click.command()

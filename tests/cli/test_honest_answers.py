@@ -214,3 +214,11 @@ def test_a_goal_part_larger_than_the_table_is_unsolvable(tmp_path):
     assert "part A (4 x 3 in) fits the 3 x 2 in table at no angle: no plan exists" in shown.output
     summary = json.loads(run("plan", str(path), "--semantics", "deterministic", "--json").stdout)
     assert summary["status"] == "unsolvable" and summary["plan_length"] is None
+    # check says so too, as a warning: the file is valid, but no plan exists
+    checked = run("check", str(path))
+    assert checked.exit_code == 0
+    assert (
+        f"{path}: warning: goal.poses.A: part A (4 x 3 in) fits the 3 x 2 in table at no angle: "
+        "no plan exists (plan answers unsolvable)"
+    ) in checked.stderr
+    assert "warning" not in run("check", "blocks-4").stderr  # a solvable problem: no warning
