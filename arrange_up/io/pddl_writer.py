@@ -23,6 +23,7 @@ from arrange_up.io.pddl_domain import (
 )
 from arrange_up.io.shape_catalogue import PDDL_NAME, Catalogue, load_catalogue
 from arrange_up.model.problem import DEFAULT_CONTROLLER, ArrangementProblem, PlanningHints
+from arrange_up.model.units import Units
 
 __all__ = ["PddlExportError", "write_pddl_problem"]
 
@@ -81,8 +82,8 @@ def write_pddl_problem(problem: ArrangementProblem, catalogue: Catalogue | None 
         if entry is None:
             known = ", ".join(e.type_name for e in catalogue.of_kind(spec.kind)) or "none"
             reasons.append(
-                f"object {spec.name!r}: its shape ({_describe_shape(spec.shape)}) is not a "
-                f"{spec.kind.value} shape of the catalogue {catalogue.path} (its "
+                f"object {spec.name!r}: its shape ({_describe_shape(spec.shape, problem.units)}) "
+                f"is not {_article(spec.kind.value)} shape of the catalogue {catalogue.path} (its "
                 f"{spec.kind.value} types: {known}); add it there to write this problem as "
                 "PDDL"
             )
@@ -211,9 +212,24 @@ def _comment_block(text: str, width: int = 96) -> list[str]:
     return ["; " + wrapped[0]] + [";   " + line for line in wrapped[1:]]
 
 
-def _describe_shape(shape: Any) -> str:
+def _article(noun: str) -> str:
+    """``noun`` with its indefinite article ("an obstacle", "a part")."""
+    return f"{'an' if noun[0] in 'aeiou' else 'a'} {noun}"
+
+
+def _describe_shape(shape: Any, units: Units) -> str:
+    """The shape for a message: a box's size in the problem's length unit (and in inches, the
+    catalogue's, when that is another), or a polygon's name and size of outline."""
     if shape.box is not None:
-        return f"box {num(shape.box[0])} x {num(shape.box[1])} in"
+        width, height = shape.box
+        size = f"box {num(width)} x {num(height)} in"
+        if units.length != "in":
+            out = units.length_out
+            size = (
+                f"box {out(width):.4g} x {out(height):.4g} {units.length} = "
+                f"{width:.4g} x {height:.4g} in"
+            )
+        return size
     name = f" {shape.name!r}" if shape.name else ""
     vertices = sum(len(p) for p in shape.parts)
     return f"polygon{name} with {vertices} vertices in {len(shape.parts)} convex parts"

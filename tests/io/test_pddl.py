@@ -28,6 +28,7 @@ from arrange_up.model.problem import (
     PlanningHints,
     problem_hash,
 )
+from arrange_up.model.units import Units
 from arrange_up.up.compile import from_up
 
 SHIPPED_PDDL = sorted(p.stem for p in domains_dir().glob("*.pddl"))
@@ -120,6 +121,25 @@ def test_export_refuses_what_pddl_cannot_express():
     # A PDDL problem is driven by the default controller: a servo problem cannot be written.
     with pytest.raises(PddlExportError, match="controller: kind servo"):
         write_pddl_problem(dataclasses.replace(problem, controller=SERVO_CONTROLLER))
+
+
+def test_an_export_refusal_gives_sizes_in_the_files_unit_and_the_catalogues():
+    problem = load("blocks-1")
+    post = build_shape("box", [0.5, 0.25], "post")
+    millimetres = dataclasses.replace(
+        problem,
+        units=Units("mm", "deg"),
+        objects=(
+            *problem.objects,
+            ObjectSpec("post", ObjectKind.OBSTACLE, post, (5.0, 2.5, 0.0)),
+        ),
+    )
+    with pytest.raises(PddlExportError) as caught:
+        write_pddl_problem(millimetres)
+    assert (
+        "object 'post': its shape (box 12.7 x 6.35 mm = 0.5 x 0.25 in) is not an obstacle "
+        "shape of the catalogue"
+    ) in str(caught.value)
 
 
 def test_export_refuses_names_pddl_cannot_carry():
