@@ -19,9 +19,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = sorted((ROOT / "benchmarks").glob("*.py"))
-# Scripts left out of the ``--help`` run, each with the reason (none so far: every script's
-# module-level imports take about a second).
-SKIP_HELP_RUN: dict[str, str] = {}
 HELP_TIMEOUT = 60.0  # seconds, for all the scripts together (they take about 1 s each)
 
 
@@ -83,7 +80,6 @@ def help_runs() -> dict[str, subprocess.CompletedProcess[str]]:
             text=True,
         )
         for path in PARSER_SCRIPTS
-        if path.name not in SKIP_HELP_RUN
     }
     runs = {}
     try:
@@ -98,11 +94,7 @@ def help_runs() -> dict[str, subprocess.CompletedProcess[str]]:
     return runs
 
 
-@pytest.mark.parametrize(
-    "path",
-    [path for path in PARSER_SCRIPTS if path.name not in SKIP_HELP_RUN],
-    ids=lambda path: path.name,
-)
+@pytest.mark.parametrize("path", PARSER_SCRIPTS, ids=lambda path: path.name)
 def test_help_exits_zero(
     path: Path, help_runs: dict[str, subprocess.CompletedProcess[str]]
 ) -> None:
