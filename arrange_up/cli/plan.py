@@ -194,7 +194,7 @@ def plan(
         workers = 1 if semantics == "deterministic" else available_cores()
     try:
         with (
-            first_interrupt_stops("the search and the validation") as interrupted,
+            first_interrupt_stops("the planning run (a plan already found is kept)") as interrupted,
             terminal_progress(TextColumn("{task.description}")) as display,
         ):
             update = None
