@@ -83,7 +83,7 @@ def write_pddl_problem(problem: ArrangementProblem, catalogue: Catalogue | None 
             known = ", ".join(e.type_name for e in catalogue.of_kind(spec.kind)) or "none"
             reasons.append(
                 f"object {spec.name!r}: its shape ({_describe_shape(spec.shape, problem.units)}) "
-                f"is not {_article(spec.kind.value)} shape of the catalogue {catalogue.path} (its "
+                f"is not {spec.kind.with_article} shape of the catalogue {catalogue.path} (its "
                 f"{spec.kind.value} types: {known}); add it there to write this problem as "
                 "PDDL"
             )
@@ -210,11 +210,6 @@ def _term(value: float) -> str:
 def _comment_block(text: str, width: int = 96) -> list[str]:
     wrapped = textwrap.wrap(text, width=width - 4) or [""]
     return ["; " + wrapped[0]] + [";   " + line for line in wrapped[1:]]
-
-
-def _article(noun: str) -> str:
-    """``noun`` with its indefinite article ("an obstacle", "a part")."""
-    return f"{'an' if noun[0] in 'aeiou' else 'a'} {noun}"
 
 
 def _describe_shape(shape: Any, units: Units) -> str:

@@ -69,8 +69,6 @@ TOP_LEVEL_KEYS = (
     "controller",
 )
 KIND_NAMES = tuple(kind.value for kind in ObjectKind)
-_ARTICLE = {"part": "a part", "manipulator": "a manipulator", "fixture": "a fixture"}
-_ARTICLE["obstacle"] = "an obstacle"
 #: The kinds that may start on the table (under 'initial'); obstacles are fixed under 'objects'.
 _MOVABLE = (ObjectKind.PART, ObjectKind.MANIPULATOR, ObjectKind.FIXTURE)
 
@@ -393,7 +391,7 @@ class ProblemBuilder(NodeReader):
             self.error(
                 node.key("pose"),
                 f"only obstacles have a pose under 'objects'; {obj.name} is "
-                f"{_ARTICLE[obj.kind.value]}: give its starting pose under 'initial' (or leave "
+                f"{obj.kind.with_article}: give its starting pose under 'initial' (or leave "
                 "it out to start it off the table)",
             )
         if obj.kind is None or obj.shape is None:
@@ -652,7 +650,7 @@ class ProblemBuilder(NodeReader):
             self.error(
                 node,
                 f"the reference of a relative goal must be a part; {obj.name} is "
-                f"{_ARTICLE[obj.kind.value]}",
+                f"{obj.kind.with_article}",
             )
             return None
         return obj.name
@@ -674,7 +672,7 @@ class ProblemBuilder(NodeReader):
             if obj is not None and obj.kind is not None and obj.kind is not ObjectKind.PART:
                 self.error(
                     key_node,
-                    f"a goal for a non-part: {obj.name} is {_ARTICLE[obj.kind.value]}; only "
+                    f"a goal for a non-part: {obj.name} is {obj.kind.with_article}; only "
                     "parts have goal poses",
                 )
                 obj = None

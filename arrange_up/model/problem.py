@@ -53,6 +53,11 @@ class ObjectKind(enum.StrEnum):
     FIXTURE = "fixture"
     OBSTACLE = "obstacle"
 
+    @property
+    def with_article(self) -> str:
+        """The kind's name with its indefinite article, for messages ("a part", "an obstacle")."""
+        return f"{'an' if self.value[0] in 'aeiou' else 'a'} {self.value}"
+
 
 @dataclass(frozen=True)
 class Shape:
