@@ -99,10 +99,14 @@ class Mates:
         )
         self._parts = {spec.name: spec.shape.parts for spec in problem.parts}
         self._ahead = lru_cache(maxsize=50_000)(self._ahead_uncached)
-        #: Where the reference is placed when it starts off the table (:meth:`_home`).
-        self.home = self._home(problem) if goal.reference is not None else None
-        #: :attr:`home`, then the alternatives tried where it has no clear place (:meth:`_homes`).
-        self.homes: tuple[Pose, ...] = self._homes(problem) if self.home is not None else ()
+        #: Where the reference is placed when it starts off the table (:meth:`_home`), then
+        #: the alternatives tried where it has no clear place (:meth:`_homes`).
+        self.home: Pose | None = None
+        self.homes: tuple[Pose, ...] = ()
+        if goal.reference is not None:
+            arrangement = self._arrangement(problem)
+            self.home = self._home(problem, arrangement)
+            self.homes = self._homes(problem, arrangement, self.home)
 
     def __bool__(self) -> bool:
         return self.reference is not None
@@ -136,24 +140,10 @@ class Mates:
         tolerance = min(self._tolerance[0], self._tolerance[1])
         return max(half[0], half[1]) <= tolerance < max(half[0], half[1]) + turned
 
-    def _home(self, problem: ArrangementProblem) -> Pose:
-        """The reference's pose (at angle 0, the frame its mates' targets are given in) that
-        centres the goal arrangement, the reference and every mate at its target by their
-        nominal footprints, on the table: a goal that lets the reference end anywhere gives
-        no place to put it down, and the middle of the table leaves the most room around the
-        arrangement for the places and pushes of its mates."""
-        shapes = [footprint(self._parts[self.reference], (0.0, 0.0, 0.0))]
-        shapes += [
-            footprint(self._parts[name], pose)
-            for name, pose in problem.goal.targets
-            if name != self.reference
-        ]
-        x0, y0, x1, y1 = shapely.union_all(shapes).bounds
-        width, depth = problem.table.size
-        return (0.5 * width - 0.5 * (x0 + x1), 0.5 * depth - 0.5 * (y0 + y1), 0.0)
-
-    def _arrangement(self, problem: ArrangementProblem):
-        """The goal arrangement's nominal footprint with the reference at the origin, angle 0."""
+    def _arrangement(self, problem: ArrangementProblem) -> shapely.Geometry:
+        """The goal arrangement's nominal footprint, the reference and every mate at its
+        target, with the reference at the origin at angle 0 (the frame its mates' targets are
+        given in)."""
         shapes = [footprint(self._parts[self.reference], (0.0, 0.0, 0.0))]
         shapes += [
             footprint(self._parts[name], pose)
@@ -162,28 +152,38 @@ class Mates:
         ]
         return shapely.union_all(shapes)
 
-    def _homes(self, problem: ArrangementProblem) -> tuple[Pose, ...]:
-        """:attr:`home`, then up to ``MAX_HOMES - 1`` other poses of the reference (angle 0)
+    @staticmethod
+    def _home(problem: ArrangementProblem, arrangement: shapely.Geometry) -> Pose:
+        """The reference's pose (at angle 0) that centres the goal ``arrangement``
+        (:meth:`_arrangement`) on the table: a goal that lets the reference end anywhere gives
+        no place to put it down, and the middle of the table leaves the most room around the
+        arrangement for the places and pushes of its mates."""
+        x0, y0, x1, y1 = arrangement.bounds
+        width, depth = problem.table.size
+        return (0.5 * width - 0.5 * (x0 + x1), 0.5 * depth - 0.5 * (y0 + y1), 0.0)
+
+    def _homes(
+        self, problem: ArrangementProblem, arrangement: shapely.Geometry, home: Pose
+    ) -> tuple[Pose, ...]:
+        """``home``, then up to ``MAX_HOMES - 1`` other poses of the reference (angle 0)
         from a ``HOME_GRID`` x ``HOME_GRID`` grid spanning the positions that keep the
-        arrangement on the table, at which the arrangement grown by the reference's place
-        noise plus ``HOME_MARGIN`` stays on the table and clear of the obstacles; nearest
-        :attr:`home` first (ties: lower y, then lower x). Deterministic: the same problem
-        gives the same homes."""
-        assert self.home is not None
+        ``arrangement`` on the table, at which it, grown by the reference's place noise plus
+        ``HOME_MARGIN``, stays on the table and clear of the obstacles; nearest ``home`` first
+        (ties: lower y, then lower x). Deterministic: the same problem gives the same homes."""
         dx, dy, dtheta = problem.uncertainty.place
-        radius = max(math.hypot(x, y) for part in self._parts[self.reference] for x, y in part)
+        radius = problem.object(self.reference).shape.radius
         margin = max(dx, dy) + radius * math.sin(min(dtheta, 0.5 * math.pi)) + HOME_MARGIN
-        grown = self._arrangement(problem).buffer(margin)
+        grown = arrangement.buffer(margin)
         x0, y0, x1, y1 = grown.bounds
         width, depth = problem.table.size
         if x1 - x0 > width or y1 - y0 > depth:
-            return (self.home,)
+            return (home,)
         obstacles = [
             footprint(spec.shape.parts, spec.pose)
             for spec in problem.obstacles
             if spec.pose is not None
         ]
-        hx, hy, _ = self.home
+        hx, hy, _ = home
         found = []
         for j in range(HOME_GRID):
             for i in range(HOME_GRID):
@@ -196,7 +196,7 @@ class Mates:
                     continue
                 found.append((round(math.hypot(x - hx, y - hy), 9), y, x))
         found.sort()
-        return (self.home, *((x, y, 0.0) for _, y, x in found[: MAX_HOMES - 1]))
+        return (home, *((x, y, 0.0) for _, y, x in found[: MAX_HOMES - 1]))
 
     def _ahead_uncached(self, name, target, mate, axis, sign) -> bool:
         other = footprint(self._parts[self.reference], mate)
