@@ -154,6 +154,7 @@ placed object's shadow must lie on the table.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from arrange_up.belief.states import IntervalBelief, symmetry_period, wrap_angle
@@ -354,14 +355,11 @@ class ActionGenerator:
                 continue
             for target in self._place_targets(spec.name, belief):
                 found = len(actions)
-                angles = self._place_angles(target)
-                for dx, dy in self.offsets[spec.name]:
-                    for theta in angles:
-                        pose = (target[0] + dx, target[1] + dy, theta)
-                        if boxes is None:
-                            boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
-                        if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
-                            actions.append(Place(spec.name, _clean(pose)))
+                for pose in self._place_grid(spec.name, target):
+                    if boxes is None:
+                        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+                    if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
+                        actions.append(Place(spec.name, _clean(pose)))
                 if len(actions) > found:
                     break
         return actions
@@ -371,18 +369,23 @@ class ActionGenerator:
         the objects on the table (those are the precondition's other half); for a relative
         goal's reference, about the first of :attr:`Mates.homes` that has any."""
         for target in self._place_targets(name, belief):
-            poses = []
-            angles = self._place_angles(target)
-            for dx, dy in self.offsets[name]:
-                for theta in angles:
-                    pose = (target[0] + dx, target[1] + dy, theta)
-                    if self.checker.shadow_inside_table(
-                        name, pose, self.place_unc
-                    ) and not self.checker.shadow_hits_fixed(name, pose, self.place_unc):
-                        poses.append(pose)
+            poses = [
+                pose
+                for pose in self._place_grid(name, target)
+                if self.checker.shadow_inside_table(name, pose, self.place_unc)
+                and not self.checker.shadow_hits_fixed(name, pose, self.place_unc)
+            ]
             if poses:
                 return poses
         return []
+
+    def _place_grid(self, name: str, target: Pose) -> Iterator[Pose]:
+        """The place poses of ``name`` about ``target``: each of its grid offsets, at each of
+        :meth:`_place_angles`, in that order."""
+        angles = self._place_angles(target)
+        for dx, dy in self.offsets[name]:
+            for theta in angles:
+                yield (target[0] + dx, target[1] + dy, theta)
 
     def _place_angles(self, target: Pose) -> tuple[float, ...]:
         """The target's angle, then each ``planning.place_angles`` offset from it, once each."""
