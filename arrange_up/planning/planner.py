@@ -175,11 +175,8 @@ class PlanResult:
         if self.solved:
             return None
         s = self.statistics
-        if self.status == SearchStatus.UNSOLVABLE:
-            if self.unfit:
-                return "; ".join(self.unfit) + ": no plan exists"
-            parts = ", ".join(m.part for m in self.misses or ())
-            return f"{parts} cannot fit on the table in any orientation: no plan exists"
+        if self.status == SearchStatus.UNSOLVABLE:  # only proven so by unfit parts
+            return "; ".join(self.unfit) + ": no plan exists"
         nodes = f"{s.expanded} node{'s' if s.expanded != 1 else ''}"
         why = "no prediction"
         if self.refusals:
