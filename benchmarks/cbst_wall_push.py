@@ -60,7 +60,7 @@ from arrange_up.cbst.features import BUCKLE_LIMIT
 from arrange_up.model.problem import Controller
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.physics.settings import push_force
-from arrange_up.physics.simulation import simulate
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, compliant_gains, simulate
 from arrange_up.physics.stall import wall_overdrive
 
 
@@ -103,14 +103,13 @@ def stiff_wrist(scale: float) -> Controller:
     """The default compliant controller with its wrist ``scale`` times as stiff and as strong
     (``kp_angle`` and the torque clip at ``scale`` times their defaults in the CBST scene)."""
     problem = _scene(DEFAULT_GENERATION)
-    paddle = problem.object("paddle").shape
-    radius = max(math.hypot(x, y) for part in paddle.parts for x, y in part)
-    kp = COMPLIANT.kp
-    return replace(
-        COMPLIANT,
-        kp_angle=scale * kp * radius * radius,
-        torque=scale * push_force(problem) * radius,
+    radius = problem.object("paddle").shape.radius
+    # the physics' own defaults; the angle gain and torque clip do not depend on the paddle's
+    # mass and moment (they set only the damping, not read here)
+    _, _, kp_angle, _, _, torque, _ = compliant_gains(
+        COMPLIANT, DEFAULT_SETTINGS, 1.0, 1.0, radius, push_force(problem)
     )
+    return replace(COMPLIANT, kp_angle=scale * kp_angle, torque=scale * torque)
 
 
 def tilt(wrists: tuple[float, ...] = ()) -> None:
