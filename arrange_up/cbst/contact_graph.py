@@ -282,6 +282,13 @@ def _contact(a: Node | Paddle, b: Node, block_size: float) -> bool | None:
     return d - (dv + a.half[1] + b.half[1]) >= MIN_OVERLAP
 
 
+def _flush(node: Node, x_max: float) -> bool:
+    """Whether ``node`` is *flush*: its position range along the push reaches within
+    :data:`FLUSH_TOLERANCE` of ``x_max``, so a push cannot move it forward by more than the
+    contact slop (a condition of a grazed object)."""
+    return node.center[0] + node.half[0] >= x_max - FLUSH_TOLERANCE
+
+
 def _shadow_overlap(a: Node, b: Node) -> float:
     """The overlap across the push (inches) of two objects' shadow boxes: a bound on how far
     a corner of ``a`` sliding past can push ``b`` aside (rotation included)."""
@@ -615,7 +622,7 @@ def _analyse(graph, paddle, reached, wall, block_size) -> PushStructure:
         node = by_name[name]
         x_max = wall - (k - 0.5) * d
         grazers = tuple(sorted(p for p in graph.predecessors(name) if p is not ROBOT))
-        flush = node.center[0] + node.half[0] >= x_max - FLUSH_TOLERANCE
+        flush = _flush(node, x_max)
         paddle_may_touch = k == length and graph.has_edge(ROBOT, name)
         if not grazers or not flush or paddle_may_touch:
             raise Unpredictable(f"{name!r} may or may not be pushed (no certain contact behind)")
