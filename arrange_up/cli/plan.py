@@ -112,11 +112,11 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     "--validate",
     type=click.IntRange(0, None),
     default=None,
-    help="Particle semantics: check a found plan on this many fresh rollouts (new initial "
-    "states and noise, judged as evaluate judges them); when some fail, search again with "
+    help="Check a found plan on this many fresh rollouts (new initial states and noise, "
+    "judged as evaluate judges them). Particle semantics: when some fail, search again with "
     "their initial states added to the particles, up to 3 more times, and return the plan "
-    "that did best. 0 turns it off. [default: twice --particles, at least 60; off for other "
-    "semantics]",
+    "that did best; other semantics report how the one plan did. 0 turns it off. [default: "
+    "twice --particles, at least 60; 60 for cbst; off for deterministic]",
 )
 @parallel_options("simulations of the successors the search will evaluate next")
 @click.option(
@@ -169,9 +169,11 @@ def plan(
     A particle plan is conformant for its particles only, so it is checked on twice --particles
     fresh rollouts, at least 60 (--validate); their failed starts become further particles of up
     to three more searches, and the line after the statistics says how the returned plan did.
-    The rollouts are seeded apart from evaluate's, which stays a fresh test. --timeout covers
-    them too: a plan found in time is returned with the rollouts that fitted, and the line says
-    how many of the asked-for ones ran.
+    A cbst plan is checked on 60 (its beliefs are learned predictions, not bounds); it has no
+    particles to add failed starts to, so the line reports how it did. A deterministic plan is
+    checked only with --validate. The rollouts are seeded apart from evaluate's, which stays a
+    fresh test. --timeout covers them too: a plan found in time is returned with the rollouts
+    that fitted, and the line says how many of the asked-for ones ran.
 
     Ctrl-C stops the run in order: during a search, the status is cancelled (written to
     --output like any other); during a validation, the plan found is kept with the rollouts

@@ -33,10 +33,12 @@ from arrange_up.planning.validation import (
     ValidationRound,
     check_validate,
     choose_round,
-    default_validation_rollouts,
+    default_validation,
+    research_on_failure,
     validate_plan,
 )
 from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_first_search
+from arrange_up.transitions import simulates_pushes
 
 __all__ = [
     "CANCELLED",
@@ -343,24 +345,29 @@ def plan(
         :class:`~arrange_up.belief.states.IntervalBelief` for ``cbst``. Closed-loop execution
         replans from its posterior this way (:mod:`arrange_up.execution.replanning`).
     validate
-        Rollouts that check a plan the ``particles`` semantics found on fresh initial states and
-        noise (:mod:`arrange_up.planning.validation`); when some fail, their initial states join
-        the search's particles (at most ``particles`` of them per round) and the search runs again,
-        at most :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while
-        ``timeout`` leaves time. The plan returned is the one that succeeded in most validation
-        rollouts, and :attr:`PlanResult.validation` says how each search did. ``None`` (default):
-        twice ``particles``, at least 60, for the ``particles`` semantics planning from the
-        problem's initial belief, else 0 (off); 0 turns it off. Other semantics, and a ``start``
-        belief (a posterior, not the problem's initial uncertainty), take no validation: a positive
-        value for them raises ``ValueError``.
+        Rollouts that check a found plan on fresh initial states and noise
+        (:mod:`arrange_up.planning.validation`). Under the ``particles`` semantics, when some
+        fail, their initial states join the search's particles (at most ``particles`` of them
+        per round) and the search runs again, at most
+        :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while ``timeout``
+        leaves time; the plan returned is the one that did best. Under the other semantics the
+        one plan is checked and returned as it did. :attr:`PlanResult.validation` says how each
+        search did. ``None`` (default): twice ``particles``, at least 60, for the ``particles``
+        semantics and 60 for ``cbst`` (conformant plans), 0 (off) for ``deterministic`` (nominal
+        plans); 0 turns it off. A ``start`` belief (a posterior, not the problem's initial
+        uncertainty) takes no validation: a positive value with one raises ``ValueError``.
     """
     check_validate(validate, semantics, start)
     if validate is None:
-        validate = (
-            default_validation_rollouts(particles)
-            if semantics == "particles" and start is None
-            else 0
-        )
+        validate = default_validation(semantics, particles, start)
+    research = research_on_failure(semantics)
+    # The search's runner checks its plans too; a semantics that starts no workers or cluster
+    # for its search (cbst predicts in this process) starts none to check its plan.
+    runner = (
+        {"workers": workers, "backend": backend, "scheduler": scheduler}
+        if simulates_pushes(semantics)
+        else {"workers": 1, "backend": "local", "scheduler": None}
+    )
     started = time.monotonic()
 
     def search(start: Any, particles: int, number: int = 1) -> PlanResult:
@@ -407,8 +414,8 @@ def plan(
     found: list[PlanResult] = []
     rounds: list[ValidationRound] = []
     failed: tuple[WorldState, ...] = ()
-    size = particles
-    for round_ in range(VALIDATION_REPLANS + 1):
+    size: int | None = particles if research else None
+    for round_ in range(VALIDATION_REPLANS + 1 if research else 1):
         if round_:
             belief = found[-1].beliefs[0]  # type: ignore[index]  # a solved search's start
             belief = ParticleBelief(belief.particles + failed[:particles])
@@ -423,10 +430,8 @@ def plan(
             rollouts=validate,
             seed=seed,
             round_=round_,
-            workers=workers,
-            backend=backend,
-            scheduler=scheduler,
             should_stop=stop,
+            **runner,
         )
         rounds.append(
             ValidationRound(size, result.status, result.stats["expanded"], successes, run)

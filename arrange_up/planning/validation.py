@@ -1,4 +1,4 @@
-"""Checking a particle plan on fresh rollouts, and planning again from the starts it failed on.
+"""Checking a found plan on fresh rollouts, and planning again from the starts it failed on.
 
 A plan the particle search finds is conformant for its particles only: every particle, with
 the noise drawn for it, reaches the goal. How far that carries to the problem's whole
@@ -9,6 +9,12 @@ rules (:mod:`arrange_up.evaluation.rollouts`). The initial states of the rollout
 are *counterexamples*: :func:`arrange_up.planning.planner.plan` adds them to the search's
 initial belief as further particles and searches again, a few rounds at most, so the next plan
 must also bring those starts (with noise drawn anew for them) to the goal.
+
+A CBST plan is checked the same way, by default too: its interval beliefs come from learned
+predictions and a grazing rule, which are not bounds (docs/cbst.md, "How far the predictions
+hold"), so only rollouts say how it does. It has no particles to add counterexamples to, so
+its validation is the one round, reported. A deterministic plan (a nominal plan, not a
+conformant one) is checked only when asked, in one round as well.
 
 The validation rollouts are an evaluation with a seed of their own, derived from the planning
 seed and the round (:func:`validation_seed`), never a small integer: an evaluation a user runs
@@ -42,6 +48,7 @@ __all__ = [
     "ValidationRound",
     "check_validate",
     "choose_round",
+    "default_validation",
     "default_validation_rollouts",
     "validate_plan",
     "validation_seed",
@@ -68,17 +75,37 @@ def default_validation_rollouts(particles: int) -> int:
     return max(2 * particles, MIN_VALIDATION_ROLLOUTS)
 
 
+def default_validation(semantics: str, particles: int, start: Any = None) -> int:
+    """The validation rollouts of a planning run that asks for none: for the conformant
+    semantics planning from the problem's initial belief, :func:`default_validation_rollouts`
+    of the particles searched (``particles``; CBST's interval belief counts as its two corner
+    pseudo-particles), else 0 (the deterministic semantics' nominal plans, and plans from a
+    ``start`` belief)."""
+    if start is not None:
+        return 0
+    if semantics == "particles":
+        return default_validation_rollouts(particles)
+    if semantics == "cbst":
+        return default_validation_rollouts(2)
+    return 0
+
+
+def research_on_failure(semantics: str) -> bool:
+    """Whether a failed validation searches again with the failed starts as further particles:
+    only the ``particles`` semantics has particles to add them to."""
+    return semantics == "particles"
+
+
 def check_validate(validate: Any, semantics: str, start: Any = None) -> None:
-    """``ValueError`` unless ``validate`` suits a planning run of ``semantics`` (from a
-    ``start`` belief when one is given): None (the default), or a non-negative integer that is
-    positive only for the ``particles`` semantics planning from the problem's initial belief
-    (the validation rollouts start from that belief, not from a posterior)."""
+    """``ValueError`` unless ``validate`` suits a planning run (from a ``start`` belief when one
+    is given): None (the default), or a non-negative integer that is positive only when
+    planning from the problem's initial belief (the validation rollouts start from that belief,
+    not from a posterior). Every semantics takes it (``semantics`` is for the signature)."""
+    del semantics  # every semantics' plan can be checked on rollouts
     if validate is None:
         return
     if not isinstance(validate, int) or isinstance(validate, bool) or validate < 0:
         raise ValueError(f"validate must be a non-negative integer, got {validate!r}")
-    if validate and semantics != "particles":
-        raise ValueError(f"validate checks particle plans; the {semantics} semantics takes none")
     if validate and start is not None:
         raise ValueError(
             "validate checks plans from the problem's initial belief; a start belief takes none"
@@ -95,12 +122,13 @@ def validation_seed(seed: int, round_: int) -> int:
 @dataclass(frozen=True)
 class ValidationRound:
     """One search of a validated planning run: the particles it searched with (the requested
-    ones plus the counterexamples of the earlier rounds), its status and expanded nodes, and,
+    ones plus the counterexamples of the earlier rounds; None for a semantics without
+    particles, which searches once), its status and expanded nodes, and,
     for a found plan, how many validation rollouts ran on it (``run``: all the run asked for
     unless the time limit or a stop came first) and how many of those succeeded
     (``successes``); both ``None`` without a plan."""
 
-    particles: int
+    particles: int | None
     status: str
     expanded: int
     successes: int | None
@@ -181,10 +209,11 @@ class Validation:
             )
         else:
             text = f"not validated: {self.stopped_by} came before any of {self.rollouts} rollouts"
-        text += (
-            f" (plan of search {self.chosen + 1} of {len(self.rounds)}, "
-            f"{chosen.particles} particles)"
-        )
+        if chosen.particles is not None:
+            text += (
+                f" (plan of search {self.chosen + 1} of {len(self.rounds)}, "
+                f"{chosen.particles} particles)"
+            )
         if len(self.rounds) > 1:
             text += "; searches: " + ", ".join(
                 f"{r.particles} particles {r.status}"

@@ -86,6 +86,21 @@ def available() -> tuple[str, ...]:
     return tuple(_REGISTRY)
 
 
+def _factory(name: str) -> Callable[..., Semantics]:
+    """The registered class (or factory) of the named semantics; ``ValueError`` naming the
+    registered ones when ``name`` is unknown."""
+    if name not in _REGISTRY:
+        raise ValueError(f"unknown semantics {name!r}; expected one of {', '.join(_REGISTRY)}")
+    module, attribute = _REGISTRY[name]
+    return getattr(importlib.import_module(module), attribute)
+
+
+def simulates_pushes(name: str) -> bool:
+    """Whether the named semantics simulates pushes (and so plans with the runner's workers),
+    read from its class without instantiating it. ``ValueError`` for an unknown name."""
+    return bool(_factory(name).simulates_pushes)  # type: ignore[attr-defined]
+
+
 def make_semantics(
     name: str,
     problem: ArrangementProblem,
@@ -104,10 +119,7 @@ def make_semantics(
     Raises ``ValueError`` naming the registered semantics when ``name`` is unknown, and when a
     ``model`` is given to a semantics without one.
     """
-    if name not in _REGISTRY:
-        raise ValueError(f"unknown semantics {name!r}; expected one of {', '.join(_REGISTRY)}")
-    module, attribute = _REGISTRY[name]
-    factory = getattr(importlib.import_module(module), attribute)
+    factory = _factory(name)
     if model is None:
         return factory(problem, particles=particles, seed=seed, workers=workers)
     if "model" not in inspect.signature(factory).parameters:

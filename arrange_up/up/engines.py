@@ -38,9 +38,10 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
 
 Parameters (``OneshotPlanner(name="arrange-up", params={...})``): ``semantics`` (default
 ``"particles"``), ``particles`` (50), ``seed`` (0), ``max_nodes`` (the problem's hint or 5000),
-``validate`` (``particles`` only: fresh rollouts that check a found plan, whose failed starts join
-the particles of up to three more searches; default twice ``particles``, at least 60, 0 off; the
-returned plan's figures are the metrics ``validation_rollouts``, ``validation_successes`` and
+``validate`` (fresh rollouts that check a found plan; under ``particles`` their failed starts join
+the particles of up to three more searches; default twice ``particles``, at least 60, for
+``particles``, 60 for ``cbst``, 0 (off) for ``deterministic``; 0 turns it off; the returned plan's
+figures are the metrics ``validation_rollouts``, ``validation_successes`` and
 ``validation_searches``, and a log line), ``model`` (``cbst`` only: a shipped model name or the
 card path of a model ``arrange-up train-cbst`` made; default the shipped one for the problem's
 controller; it is loaded and checked when the engine is made, and a problem whose controller is not

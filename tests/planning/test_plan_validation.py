@@ -14,6 +14,7 @@ from arrange_up.cli import main
 from arrange_up.cli.plan import _status_line
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.rollouts import rollout_start, trace_rollout
+from arrange_up.io.domains import load
 from arrange_up.io.yaml_problem import load_problem
 from arrange_up.planning import validation as validation_module
 from arrange_up.planning.planner import plan
@@ -105,23 +106,36 @@ def test_validation_seeds_are_apart_from_evaluation_seeds_and_from_each_other() 
     assert validation_seed(2, 1) == validation_seed(2, 1)
 
 
-def test_validation_is_on_by_default_for_particles_only(narrow) -> None:
+def test_validation_is_on_by_default_for_the_conformant_semantics(narrow) -> None:
     particles = plan(narrow, particles=3, seed=0, workers=1)
     assert particles.validation is not None and particles.validation.rollouts == 60
-    assert plan(narrow, semantics="deterministic").validation is None
+    # a CBST plan is checked too: its beliefs are predictions, not bounds (docs/cbst.md)
+    cbst = plan(load("blocks-2"), semantics="cbst")
+    assert cbst.solved and cbst.validation is not None
+    assert cbst.validation.rollouts == cbst.validation.run == 60
+    assert [r.particles for r in cbst.validation.rounds] == [None]  # one round, no particles
+    assert plan(narrow, semantics="deterministic").validation is None  # a nominal plan
     # a start belief is a posterior, not the initial uncertainty the rollouts draw from
     start = particles.beliefs[0]
     assert plan(narrow, particles=3, seed=0, workers=1, start=start).validation is None
 
 
-@pytest.mark.parametrize(
-    "arguments",
-    [
-        {"validate": -1},
-        {"validate": 5, "semantics": "deterministic"},
-        {"validate": 5, "semantics": "cbst"},
-    ],
-)
+def test_a_deterministic_plan_is_checked_when_asked_and_kept_as_it_did() -> None:
+    # The nominal plan of blocks-4 puts the paddle down onto parts in most noisy rollouts:
+    # its validation says so, and no further search runs (there are no particles to add).
+    problem = load("blocks-4")
+    nominal = plan(problem, semantics="deterministic", validate=0)
+    checked = plan(problem, semantics="deterministic", validate=20)
+    assert checked.solved and checked.actions == nominal.actions
+    validation = checked.validation
+    assert validation is not None and len(validation.rounds) == 1
+    assert validation.run == 20 and validation.successes < 20 and not validation.passed
+    line = validation.line()
+    assert line.startswith(f"validated on 20 fresh rollouts: {validation.successes} succeeded")
+    assert "particles" not in line and "search" not in line
+
+
+@pytest.mark.parametrize("arguments", [{"validate": -1}, {"validate": 2.5}, {"validate": True}])
 def test_bad_validation_arguments_raise(narrow, arguments) -> None:
     with pytest.raises(ValueError, match="validate"):
         plan(narrow, particles=2, **arguments)
@@ -142,12 +156,12 @@ def test_the_command_line_reports_and_records_the_validation(tmp_path: Path) -> 
     assert "validated on 10 fresh rollouts: 10 succeeded (plan of search 2 of 2" in table.output
 
 
-def test_validate_with_another_semantics_exits_2() -> None:
-    result = CliRunner().invoke(
-        main, ["plan", str(NARROW), "--semantics", "deterministic", "--validate", "4"]
-    )
-    assert result.exit_code == 2
-    assert "--validate checks particle plans" in result.output
+def test_the_command_line_validates_other_semantics_as_asked() -> None:
+    args = ["plan", str(NARROW), "--semantics", "deterministic"]
+    assert "validated" not in CliRunner().invoke(main, args).output
+    result = CliRunner().invoke(main, [*args, "--validate", "4"])
+    assert result.exit_code == 0, result.output
+    assert "validated on 4 fresh rollouts: " in result.output
 
 
 def test_the_time_limit_holds_while_a_plan_is_validated(narrow) -> None:

@@ -114,8 +114,8 @@ def test_parameters_are_checked():
         OneshotPlanner(name="arrange-up", params={"particles": 0})
     with pytest.raises(ValueError, match="validate must be a non-negative integer"):
         OneshotPlanner(name="arrange-up", params={"validate": -1})
-    with pytest.raises(ValueError, match="validate checks particle plans"):
-        OneshotPlanner(name="arrange-up", params={"semantics": "cbst", "validate": 4})
+    with pytest.raises(ValueError, match="validate must be a non-negative integer"):
+        OneshotPlanner(name="arrange-up", params={"semantics": "cbst", "validate": 2.5})
     # a negative seed, for every engine and semantics, when the engine is made
     for make, engine in (
         (OneshotPlanner, "arrange-up"),
