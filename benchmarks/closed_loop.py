@@ -32,7 +32,7 @@ from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.replanning import ClosedLoopSettings
 from arrange_up.io.domains import load
-from arrange_up.io.planfile import plan_problem_mismatch, read_plan, write_json_atomic
+from arrange_up.io.planfile import plan_problem_mismatches, read_plan, write_json_atomic
 from arrange_up.model.problem import driven_by
 from arrange_up.planning.planner import plan
 
@@ -212,7 +212,7 @@ def first_plan(problem, args, path: Path) -> tuple | None:
     the planner found none."""
     if path.exists():
         actions, document = read_plan(path, problem)
-        mismatch = plan_problem_mismatch(document, problem)
+        mismatch = "; and ".join(plan_problem_mismatches(document, problem))
         if mismatch:
             raise SystemExit(f"{path}: {mismatch}; delete it to plan again")
         print(f"{problem.name}: first plan read from {path}", flush=True)

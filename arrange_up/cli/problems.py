@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from arrange_up.cli.shared import EXIT_NEGATIVE, OutputFile, fail, load_problem
+from arrange_up.cli.shared import EXIT_BAD_INPUT, EXIT_NEGATIVE, OutputFile, fail, load_problem
 from arrange_up.io.domains import (
     UnknownDomainError,
     check_problem_file,
@@ -51,8 +51,8 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
     every file is reported at once, as FILE:LINE:COL: severity: key.path: message; a file that
     cannot be read (or a folder) is reported and the others still checked. Two files of one
     folder may not hold problems of the same name, except a problem's YAML and PDDL twins
-    (same file name, other suffix). Exits 1 if any file has errors, 0 otherwise (warnings do
-    not fail).
+    (same file name, other suffix). Exits 2 if any file has errors (bad input, as plan,
+    evaluate and show exit on the same file), 0 otherwise (warnings do not fail).
     """
     failed = 0
     names: dict[tuple[Path, str], Path] = {}
@@ -90,7 +90,9 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
                 f"{'relative' if problem.goal.is_relative else 'absolute'} goal)"
             )
     if failed:
-        fail(f"{failed} of {len(files)} file(s) failed", EXIT_NEGATIVE)
+        # An invalid file is bad input, whichever command is given it: check reports it as
+        # every other command does (exit 2), so a script need not know which one ran.
+        fail(f"{failed} of {len(files)} file(s) failed", EXIT_BAD_INPUT)
 
 
 def _warn_unfit(shown: str, problem: ArrangementProblem) -> None:

@@ -4,8 +4,9 @@ types that validate values before any work (:data:`SEED`, :class:`FiniteFloat`,
 check, the parallel options, the progress display, JSON and table output, and the library
 defaults the options show.
 
-Exit status: 0 success; 1 the job ran but its answer is negative (e.g. a problem file has
-errors under ``check``); 2 bad input (unreadable or invalid problem, unknown domain, bad option).
+Exit status: 0 success; 1 the job ran but its answer is negative (e.g. ``plan`` found no
+plan); 2 bad input (unreadable or invalid problem, also under ``check``, unknown domain, bad
+option).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from rich.progress import Progress, ProgressColumn
 
 from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.io.domains import UnknownDomainError, load_checked
-from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_mismatch, read_plan
+from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_mismatches, read_plan
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
@@ -202,14 +203,15 @@ def read_plan_file(
     problem: ArrangementProblem, plan_file: str, *, warn_mismatch: bool
 ) -> tuple[tuple[Action, ...], dict[str, Any]]:
     """Read a plan file for ``problem`` as (actions, document): a clean message and exit 2 on a
-    bad file; with ``warn_mismatch``, a warning when the plan was made for other problem
-    content."""
+    bad file; with ``warn_mismatch``, one warning for each way the plan was made for other than
+    ``problem`` (other problem content, another controller: :func:`plan_problem_mismatches`)."""
     try:
         actions, document = read_plan(plan_file, problem)
     except PlanFileError as error:
         fail(str(error))
-    mismatch = plan_problem_mismatch(document, problem) if warn_mismatch else None
-    if mismatch:
+    # One line each: a plan of another problem under another controller is wrong twice, and
+    # each line reads alone, as every diagnostic does.
+    for mismatch in plan_problem_mismatches(document, problem) if warn_mismatch else ():
         click.echo(f"arrange-up: warning: {plan_file}: {mismatch}; using it anyway", err=True)
     return actions, document
 

@@ -496,7 +496,7 @@ class _Builder:
 
     def angle(self, path: str, pattern: str, degrees: Fraction) -> bool:
         """Whether ``degrees`` is a usable angle (see :data:`validation.MAX_ANGLE`)."""
-        reason = validation.angle_problem(PDDL_UNITS.angle_in(float(degrees)))
+        reason = validation.angle_problem(PDDL_UNITS.angle_in(float(degrees)), PDDL_UNITS.angle)
         if reason is not None:
             self.error(path, pattern, f"angle {num(float(degrees))} deg: {reason}")
             return False

@@ -22,13 +22,14 @@ Poses and distances are in the problem's own units (``units``). ``actions`` is p
 the plan complete, only when ``status`` is ``"solved"``; any other status records an honest
 failure with its search statistics. ``hash`` identifies the problem's content (see
 :func:`arrange_up.model.problem.problem_hash`); the commands that read plans warn when it does not
-match the problem they are given (:func:`plan_problem_mismatch`). ``controller`` is the problem's
-push controller (:func:`controller_to_json`); a file without one was made before plan files
-recorded it, when every problem was driven by the servo.
+match the problem they are given, and of every other mismatch (:func:`plan_problem_mismatches`).
+``controller`` is the problem's push controller (:func:`controller_to_json`); a file without one
+was made before plan files recorded it, when every problem was driven by the servo.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -43,6 +44,7 @@ from arrange_up.io.yaml_settings import SERVO_KEYS, controller_factors
 from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import (
     ArrangementProblem,
+    Controller,
     ControllerKind,
     ObjectKind,
     problem_hash,
@@ -106,7 +108,7 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
         ):
             raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {_shown(pose)}")
         internal = units.pose_in(tuple(pose))  # type: ignore[arg-type]
-        reason = angle_problem(internal[2])
+        reason = angle_problem(internal[2], units.angle)
         if reason is not None:
             raise PlanFileError(f"{where}.pose[2]: angle {pose[2]:g} {units.angle}: {reason}")
         return internal
@@ -335,28 +337,69 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
     return actions, document
 
 
-def plan_problem_mismatch(document: Mapping[str, Any], problem: ArrangementProblem) -> str | None:
-    """A warning if the plan ``document`` was made for a problem other than ``problem``."""
-    recorded = document.get("problem", {}) if isinstance(document, Mapping) else {}
+def plan_problem_mismatches(document: Mapping[str, Any], problem: ArrangementProblem) -> list[str]:
+    """Every way the plan ``document`` was made for other than ``problem``, each a warning;
+    empty when it fits or records nothing to compare.
+
+    In order: a ``problem`` record that is not an object, or one of another problem (its hash
+    differs from ``problem``'s); a push controller of another kind (a file recording its problem
+    but no controller was made under the servo). The hash covers the controller, so when the
+    controllers differ the content is compared as if ``problem`` had the plan's: a plan of the
+    same problem under another controller is warned of its controller only. A controller this
+    version cannot read leaves the problem's name to tell another problem.
+    """
+    if not isinstance(document, Mapping):
+        return []
+    found: list[str] = []
+    recorded = document.get("problem", {})
     if not isinstance(recorded, Mapping):
-        return f"its 'problem' is {_json_kind(recorded)}, not an object naming the problem"
+        found.append(f"its 'problem' is {_json_kind(recorded)}, not an object naming the problem")
+        recorded = {}
     # A plan file that records its problem but no controller was made under the servo.
     legacy = {"kind": ControllerKind.SERVO.value} if recorded else None
-    controller = document.get("controller", legacy) if isinstance(document, Mapping) else None
+    controller = document.get("controller", legacy)
     kind = controller.get("kind") if isinstance(controller, Mapping) else controller
-    if controller is not None and kind != problem.controller.kind.value:
+    other_kind = controller is not None and kind != problem.controller.kind.value
+    recorded_hash, expected = recorded.get("hash"), problem_hash(problem)
+    if recorded_hash not in (None, expected):
+        same = False
+        if other_kind:
+            # The hash covers the controller, which is said below: compare the rest.
+            planned_under = _controller_from_json(controller, document.get("units"))
+            if planned_under is None:
+                same = recorded.get("name") == problem.name
+            else:
+                under = dataclasses.replace(problem, controller=planned_under)
+                same = recorded_hash == problem_hash(under)
+        if not same:
+            found.append(
+                f"it was planned for problem {recorded.get('name')!r} with other content "
+                f"than {problem.name!r} ({recorded_hash} vs {expected})"
+            )
+    if other_kind:
         why = " (it names no controller: it was made when the servo was every problem's)"
-        return (
+        found.append(
             f"it was planned under the {kind if isinstance(kind, str) else _shown(kind)} "
             f"controller; problem {problem.name!r} uses the {problem.controller.kind.value} "
             f"one{why if controller is legacy else ''}"
         )
-    if recorded.get("hash") not in (None, problem_hash(problem)):
-        return (
-            f"it was planned for problem {recorded.get('name')!r} with other content "
-            f"than {problem.name!r} ({recorded.get('hash')} vs {problem_hash(problem)})"
-        )
-    return None
+    return found
+
+
+def _controller_from_json(data: Any, units: Any) -> Controller | None:
+    """The controller a plan file records (:func:`controller_to_json`, in its ``units``), or
+    ``None`` when it cannot be read as one (another version's kind, a value not a number)."""
+    if not isinstance(data, Mapping) or not isinstance(units, Mapping | None):
+        return None
+    try:
+        kind = ControllerKind(data.get("kind"))
+        factors = controller_factors(Units(**(units or {})))
+    except (TypeError, ValueError):
+        return None
+    values = {key: data[key] for key in factors if key in data}
+    if not all(_is_number(value) for value in values.values()):
+        return None
+    return Controller(kind=kind, **{key: value * factors[key] for key, value in values.items()})
 
 
 def _pose_out(pose: Sequence[float], units: Units) -> list[float]:

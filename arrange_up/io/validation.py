@@ -39,6 +39,7 @@ from arrange_up.model.problem import (
     Pose,
     Shape,
 )
+from arrange_up.model.units import ANGLE_UNITS
 
 __all__ = [
     "AREA_TOLERANCE",
@@ -191,12 +192,18 @@ def part_overlaps(
     return [(i, j, area) for j, pairs in sorted(overlapping.items()) for i, area in pairs]
 
 
-def angle_problem(value: float) -> str | None:
-    """Why the angle ``value`` (radians) is refused, or ``None`` when it is usable."""
+def angle_problem(value: float, unit: str = "rad") -> str | None:
+    """Why the angle ``value`` (radians) is refused, or ``None`` when it is usable.
+
+    The message states the limit in ``unit`` (a key of :data:`~arrange_up.model.units.ANGLE_UNITS`):
+    the unit the angle was written in, which the caller's message quotes the angle in.
+    """
     if math.isfinite(value) and abs(value) <= MAX_ANGLE:
         return None
+    # One unit in a message: "1e+300 deg ... at most 1.67772e+07 rad" reads as a wrong bound.
+    limit = MAX_ANGLE / ANGLE_UNITS[unit]
     return (
-        f"expected an angle of magnitude at most {MAX_ANGLE:g} rad (beyond it a double cannot "
+        f"expected an angle of magnitude at most {limit:g} {unit} (beyond it a double cannot "
         "resolve the orientation; give the angle modulo a full turn)"
     )
 

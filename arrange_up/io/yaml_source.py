@@ -455,7 +455,7 @@ class NodeReader:
         """``value`` (the file's angle unit, read from ``node``) in radians, or None after
         reporting an angle too large to mean an orientation (:data:`validation.MAX_ANGLE`)."""
         radians = self.units.angle_in(value)
-        reason = angle_problem(radians)
+        reason = angle_problem(radians, self.units.angle)
         if reason is not None:
             self.error(node, f"angle {fmt(value)} {self.units.angle}: {reason}")
             return None

@@ -309,6 +309,59 @@ def test_the_valid_files_the_cases_start_from_are_accepted(tmp_path):
         assert "warning" not in result.output
 
 
+# -- an angle too large, in the unit it was written in --------------------------------------
+_LIMIT = "expected an angle of magnitude at most"
+_HUGE_GOAL_ANGLE = ("poses: {A: [5, 2, 0]}", "poses: {A: [5, 2, 1e300]}")
+_IN_RADIANS = _yaml("name: one\n", "name: one\nunits: {angle: rad}\n")
+#: id -> (file name, content, the command before the file, the command after it, the message:
+#: the angle and the limit both in the unit of the file, degrees unless it says otherwise)
+ANGLE_UNIT_CASES: dict[str, tuple[str, str, list[str], list[str], str]] = {
+    "yaml-degrees": (
+        "deg.yaml",
+        _yaml(*_HUGE_GOAL_ANGLE),
+        ["check"],
+        [],
+        f"goal.poses.A[2]: angle 1e+300 deg: {_LIMIT} 9.61264e+08 deg (",
+    ),
+    "yaml-radians": (
+        "rad.yaml",
+        _IN_RADIANS.replace(*_HUGE_GOAL_ANGLE),
+        ["check"],
+        [],
+        f"goal.poses.A[2]: angle 1e+300 rad: {_LIMIT} 1.67772e+07 rad (",
+    ),
+    "pddl": (
+        "huge.pddl",
+        PDDL_CASES["angle-huge-goal"][0],
+        ["check"],
+        [],
+        f"{_LIMIT} 9.61264e+08 deg (",
+    ),
+    "plan-degrees": (
+        "deg.json",
+        _pose("[9.5, 0.5, 1e300]"),
+        ["evaluate", "blocks-1"],
+        ["--rollouts", "1", "--workers", "1"],
+        f"pose[2]: angle 1e+300 deg: {_LIMIT} 9.61264e+08 deg (",
+    ),
+    "plan-radians": (
+        "rad.json",
+        _pose("[9.5, 0.5, 1e300]").replace('"angle": "deg"', '"angle": "rad"'),
+        ["evaluate", "blocks-1"],
+        ["--rollouts", "1", "--workers", "1"],
+        f"pose[2]: angle 1e+300 rad: {_LIMIT} 1.67772e+07 rad (",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(ANGLE_UNIT_CASES))
+def test_an_angle_too_large_is_refused_with_the_limit_in_the_files_unit(tmp_path, case):
+    name, content, before, after, message = ANGLE_UNIT_CASES[case]
+    path = _write(tmp_path / name, content)
+    result = _invoke([*before, str(path), *after])
+    _assert_refused(result, str(path), message)
+
+
 # -- command lines ---------------------------------------------------------------------------
 QUICK_PLAN = ["plan", "blocks-1", "--semantics", "particles", "--particles", "2"]
 QUICK_PLAN += ["--max-nodes", "1", "--workers", "1"]

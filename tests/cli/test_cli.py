@@ -45,10 +45,22 @@ def test_check_accepts_valid_and_reports_every_error(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text(BAD)
     result = CliRunner().invoke(main, ["check", str(bad)])
-    assert result.exit_code == 1
+    assert result.exit_code == 2  # bad input, as every command that loads the file says
     assert f"{bad}:4:" in result.output  # the unknown kind, with its line
     assert f"{bad}:6:" in result.output  # the undeclared goal part, with its line
     assert "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("command", ["check", "plan", "evaluate", "show"])
+def test_every_command_exits_2_on_an_invalid_problem_file(tmp_path, command):
+    # The contract: bad input exits 2 whatever the command; check's answer about an invalid
+    # file is that input being bad, not a negative answer (exit 1) about a good one.
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(BAD)
+    extra = {"evaluate": [str(tmp_path / "plan.json")], "show": ["-o", str(tmp_path / "b.png")]}
+    result = CliRunner().invoke(main, [command, str(bad), *extra.get(command, [])])
+    assert result.exit_code == 2, result.output
+    assert f"{bad}:4:" in result.output and "Traceback" not in result.output
 
 
 def test_check_valid_shipped_file_by_path():

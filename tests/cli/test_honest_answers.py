@@ -99,6 +99,30 @@ def test_a_goal_that_sticks_out_of_the_table_is_warned_about(tmp_path):
     )
 
 
+def test_a_plan_of_another_problem_under_another_controller_is_warned_of_both(tmp_path):
+    # blocks-1's plan (made under the default, compliant, controller) given a servo blocks-2:
+    # two mismatches, each its own warning in the words it has alone, neither hiding the other.
+    plan = tmp_path / "b1.json"
+    planned = run("plan", "blocks-1", "--semantics", "deterministic", "-o", str(plan))
+    assert planned.exit_code == 0, planned.output
+    problem = tmp_path / "blocks-2-servo.yaml"
+    text = (REPOSITORY / "domains" / "blocks-2.yaml").read_text()
+    problem.write_text(text + "controller: {kind: servo}\n")
+    result = run("evaluate", str(problem), str(plan), "--rollouts", "1", "--workers", "1")
+    assert result.exit_code == 0, result.output
+    recorded = json.loads(plan.read_text())["problem"]["hash"]
+    other, controller = [line for line in result.stderr.splitlines() if "warning" in line]
+    assert other.startswith(
+        f"arrange-up: warning: {plan}: it was planned for problem 'blocks-1' with other content "
+        f"than 'blocks-2' ({recorded} vs sha256:"
+    )
+    assert other.endswith("); using it anyway")
+    assert controller == (
+        f"arrange-up: warning: {plan}: it was planned under the compliant controller; problem "
+        "'blocks-2' uses the servo one; using it anyway"
+    )
+
+
 # -- check ---------------------------------------------------------------------------------
 def test_check_accepts_shipped_names_like_every_other_command():
     result = run("check", "blocks-1", "tz-mating.pddl")
@@ -120,7 +144,7 @@ def test_check_still_refuses_two_problems_of_one_name_in_a_folder(tmp_path):
     (tmp_path / "one.yaml").write_text(text)
     (tmp_path / "two.yaml").write_text(text)
     result = run("check", str(tmp_path / "one.yaml"), str(tmp_path / "two.yaml"))
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert "problem name 'blocks-1' is already used by" in result.output
     # at the name's place, as every diagnostic of check is
     line = next(n for n, t in enumerate(text.splitlines(), 1) if t.startswith("name:"))
@@ -133,7 +157,7 @@ def test_a_pddl_name_clash_is_reported_at_the_name_not_at_a_comment(tmp_path):
     decoy = "; an old copy said (problem decoy)\n"
     (tmp_path / "two.pddl").write_text(decoy + text)
     result = run("check", str(tmp_path / "one.pddl"), str(tmp_path / "two.pddl"))
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     lines = (decoy + text).splitlines()
     line, column = next(
         (n, t.lower().index("(problem") + len("(problem ") + 1)
@@ -146,7 +170,7 @@ def test_a_pddl_name_clash_is_reported_at_the_name_not_at_a_comment(tmp_path):
 def test_check_reports_a_folder_or_a_missing_file_and_checks_the_rest(tmp_path):
     missing = tmp_path / "missing.yaml"
     result = run("check", str(tmp_path), "blocks-1", str(missing), "blocks-2")
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert f"{tmp_path}: error: " in result.output and "is a directory" in result.output
     assert f"{missing}: error: " in result.output
     assert "ok: blocks-1" in result.output and "ok: blocks-2" in result.output

@@ -19,7 +19,7 @@ from arrange_up.io.planfile import (
     action_from_json,
     action_to_json,
     plan_document,
-    plan_problem_mismatch,
+    plan_problem_mismatches,
     read_plan,
     write_json_atomic,
     write_text_atomic,
@@ -258,22 +258,73 @@ def test_read_plan_of_a_missing_file_or_not_json(tmp_path):
 def test_plan_problem_mismatch_warns_only_for_other_content():
     one, mm = tiny("one-block"), tiny("millimetres")
     doc = document(one, ACTIONS[:2])
-    assert plan_problem_mismatch(doc, one) is None
-    warning = plan_problem_mismatch(doc, mm)
+    assert plan_problem_mismatches(doc, one) == []
+    (warning,) = plan_problem_mismatches(doc, mm)
     assert "planned for problem 'one-block'" in warning and "'millimetres'" in warning
     assert problem_hash(one) in warning and problem_hash(mm) in warning
     # The same content in other units is the same problem.
     renamed = variant("millimetres", "name: millimetres", "name: one-block")
-    assert plan_problem_mismatch(doc, renamed) is None
+    assert plan_problem_mismatches(doc, renamed) == []
     # Another controller is named as such; a file naming no controller was made by the servo.
     servo_doc = document(servo(one), ACTIONS[:2])
-    assert "planned under the servo controller" in plan_problem_mismatch(servo_doc, one)
+    (warning,) = plan_problem_mismatches(servo_doc, one)
+    assert "planned under the servo controller" in warning
     legacy = {k: v for k, v in servo_doc.items() if k != "controller"}
-    assert plan_problem_mismatch(legacy, servo(one)) is None
-    assert "planned under the servo controller" in plan_problem_mismatch(legacy, one)
+    assert plan_problem_mismatches(legacy, servo(one)) == []
+    (warning,) = plan_problem_mismatches(legacy, one)
+    assert "planned under the servo controller" in warning
     # Nothing recorded: nothing to compare.
-    assert plan_problem_mismatch({"format": PLAN_FORMAT}, mm) is None
-    assert plan_problem_mismatch([], mm) is None  # type: ignore[arg-type]
+    assert plan_problem_mismatches({"format": PLAN_FORMAT}, mm) == []
+    assert plan_problem_mismatches([], mm) == []  # type: ignore[arg-type]
+
+
+def test_plan_problem_mismatches_reports_another_problem_under_another_controller():
+    one, mm = tiny("one-block"), tiny("millimetres")
+    # Planned for another problem and under another controller: both are said, each in the
+    # words it has alone.
+    other, controller = plan_problem_mismatches(document(one, ACTIONS[:2]), servo(mm))
+    assert other == (
+        "it was planned for problem 'one-block' with other content than 'millimetres' "
+        f"({problem_hash(one)} vs {problem_hash(servo(mm))})"
+    )
+    assert controller == (
+        "it was planned under the compliant controller; problem 'millimetres' uses the servo one"
+    )
+    legacy = {k: v for k, v in document(servo(one), ACTIONS[:2]).items() if k != "controller"}
+    legacy_other, legacy_controller = plan_problem_mismatches(legacy, mm)
+    assert "planned for problem 'one-block'" in legacy_other
+    assert legacy_controller.startswith("it was planned under the servo controller; problem")
+    assert "(it names no controller: it was made when the servo was every" in legacy_controller
+    # A malformed record of the problem does not hide the controller.
+    malformed = {**document(servo(one), ACTIONS[:2]), "problem": "one-block"}
+    record, controller = plan_problem_mismatches(malformed, one)
+    assert record == "its 'problem' is the string 'one-block', not an object naming the problem"
+    assert "planned under the servo controller" in controller
+
+
+def test_another_controller_alone_is_not_another_problem():
+    # The hash covers the controller, so a plan of the same problem under another controller
+    # has another hash; judged under the controller it records (tuned, in the plan's units),
+    # the content is the same and only the controller is said.
+    tuned = variant(
+        "millimetres",
+        "name: millimetres",
+        "name: one-block\ncontroller: {kind: compliant, kp: 200, speed: 50.8, force: 254}",
+    )
+    doc = document(tuned, ACTIONS[:2])
+    assert doc["units"]["length"] == "mm" and doc["controller"]["speed"] == 50.8
+    one = tiny("one-block")
+    assert problem_hash(tuned) != problem_hash(servo(one))
+    (warning,) = plan_problem_mismatches(doc, servo(one))
+    assert warning.startswith("it was planned under the compliant controller")
+    # ... while the same kind with other gains is other content, as it always was
+    (warning,) = plan_problem_mismatches(doc, one)
+    assert "planned for problem 'one-block' with other content than 'one-block'" in warning
+    # A controller the plan names but this version cannot read: judged by the name alone.
+    unknown = {**doc, "controller": {"kind": "magic"}}
+    (warning,) = plan_problem_mismatches(unknown, one)
+    assert warning.startswith("it was planned under the magic controller")
+    assert len(plan_problem_mismatches(unknown, tiny("millimetres"))) == 2
 
 
 def test_an_atomic_write_gives_the_file_the_umask_permissions(tmp_path):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import random
 from pathlib import Path
 
@@ -119,6 +120,15 @@ def test_angles_beyond_the_resolution_of_a_double_are_refused() -> None:
     assert angle_problem(0.0) is None and angle_problem(-MAX_ANGLE) is None
     for bad in (MAX_ANGLE * 2, 1e300, float("nan"), float("inf")):
         assert "expected an angle" in (angle_problem(bad) or "")
+
+
+def test_the_angle_limit_is_stated_in_the_unit_the_angle_was_written_in() -> None:
+    # The value is in radians; the message quotes it in the file's unit, so must the limit.
+    assert "at most 1.67772e+07 rad (" in (angle_problem(1e300) or "")
+    assert "at most 1.67772e+07 rad (" in (angle_problem(1e300, "rad") or "")
+    in_degrees = angle_problem(math.radians(1e300), "deg") or ""
+    assert f"at most {math.degrees(MAX_ANGLE):g} deg (" in in_degrees
+    assert "9.61264e+08 deg" in in_degrees and "rad" not in in_degrees
 
 
 def test_a_goal_off_the_table_is_unreachable_one_at_its_edge_sticks_out() -> None:
