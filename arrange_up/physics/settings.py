@@ -82,7 +82,13 @@ class PhysicsSettings:
     reads as motion, so the drive ran to the cap. 0 turns this off; ``None``: the
     controller's (the servo 0, the compliant controller 0.5; ``docs/design/physics.md``)."""
     max_time: float = 20.0
-    """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``."""
+    """Cap on the simulated time of one push (s); hitting it gives ``NOT_AT_REST``. A push
+    whose set point reaches its end later than ``max_time - travel_margin`` at the push speed
+    is capped ``travel_margin`` after that end instead (:meth:`cap_steps`)."""
+    travel_margin: float = 10.0
+    """Simulated time (s) a long push gets after its set point's end: one longer than about
+    30 in at the default speed (a metre-scale problem's) could not arrive within ``max_time``
+    and ended ``NOT_AT_REST`` whatever happened; shorter pushes keep the ``max_time`` cap."""
     settle_steps: int = 2
     """Steps run after writing the state, before driving the manipulator: the thesis ran "a
     couple of time steps" so the engine builds its contact state first. The overlap check reads
@@ -110,6 +116,7 @@ class PhysicsSettings:
             "gravity",
             "rest_interval",
             "max_time",
+            "travel_margin",
             "push_speed",
             "push_force",
             "load_margin",
@@ -170,8 +177,13 @@ class PhysicsSettings:
 
     @property
     def max_steps(self) -> int:
-        """Steps in ``max_time`` (the cap)."""
+        """Steps in ``max_time`` (the cap of a push that arrives in time)."""
         return max(1, math.ceil(self.max_time / self.dt - 1e-9))
+
+    def cap_steps(self, setpoint_end: float) -> int:
+        """Steps a push may run whose set point reaches its end after ``setpoint_end`` seconds:
+        :attr:`max_steps`, or ``travel_margin`` after that end when it is later."""
+        return max(self.max_steps, math.ceil((setpoint_end + self.travel_margin) / self.dt))
 
 
 SERVO_VALUES: dict[str, float | int] = {

@@ -148,8 +148,9 @@ into a wall or a post wedges it, and at 5 or 10 iterations that wedge chatters u
 has advanced along the push by less than the rest speed over ``stall_window`` (0.5 s): a wedge
 that still chatters, the paddle rocking or creeping sideways with the part along a wall,
 never passes the check-to-check rest test. The whole push is capped at ``max_time`` (20 s) of
-simulated time; a cap hit is reported as ``NOT_AT_REST`` with the poses at the cap, never
-silently truncated.
+simulated time, or ``travel_margin`` (10 s) after its set point's end when that is later (a push
+longer than about 30 in at the default speed); a cap hit is reported as ``NOT_AT_REST`` with
+the poses at the cap, never silently truncated.
 
 These rest settings, the solver ``iterations`` and body sleeping (``sleep_time``: bodies idle
 that long are no longer solved until something touches them) are chosen per controller
@@ -580,7 +581,9 @@ def _push(
                     step(space, dt)
 
         interval = s.interval_steps
-        max_steps = s.max_steps
+        speed = s.push_speed if controller.speed is None else controller.speed
+        setpoint_end = distance / (track.speed if compliant else speed)
+        max_steps = s.cap_steps(setpoint_end)
         lin2 = s.rest_linear_tol * s.rest_linear_tol
         ang_tol = s.rest_angular_tol
         need = s.rest_checks
@@ -595,8 +598,6 @@ def _push(
         # A push still not at rest `stuck_time` after its set point's end gets more solver
         # iterations: chatter of a wedged contact, which more iterations settle (settings).
         if s.stuck_time > 0.0:
-            speed = s.push_speed if controller.speed is None else controller.speed
-            setpoint_end = distance / (track.speed if compliant else speed)
             stuck_at = math.ceil((setpoint_end + s.stuck_time) / dt)
         else:
             stuck_at = max_steps + 1

@@ -180,12 +180,26 @@ def test_rest_cap_reports_not_at_rest():
     problem = make_problem(1)
     state = state_of(problem, b0=(3.0, 2.5, 0.0))
     push = push_east(3.0, 2.5, 2.0)
-    capped = simulate(problem, state, push, settings=PhysicsSettings(max_time=0.05))
+    # the set point reaches its end after 2 / 3 s: the cap is the later of max_time and that
+    # end plus travel_margin
+    settings = PhysicsSettings(max_time=0.05, travel_margin=0.05)
+    capped = simulate(problem, state, push, settings=settings)
     assert capped.status is StepStatus.NOT_AT_REST
-    assert capped.sim_time == pytest.approx(0.05, abs=DEFAULT_SETTINGS.dt)
+    assert capped.sim_time == pytest.approx(2.0 / 3.0 + 0.05, abs=DEFAULT_SETTINGS.dt)
     normal = simulate(problem, state, push)
     assert normal.status is StepStatus.OK
     assert 0.5 < normal.sim_time < 3.0
+
+
+def test_a_long_push_is_not_cut_off_before_it_could_arrive():
+    # 100 inches at the default 3 in/s take 33 s, beyond the 20-s cap: before the cap made room
+    # for the travel, every such push (a metre-scale problem's) ended NOT_AT_REST.
+    problem = dataclasses.replace(make_problem(1), table=Table((120.0, 5.0)))
+    state = state_of(problem, b0=(10.0, 2.5, 0.0))
+    outcome = simulate(problem, state, push_east(10.0, 2.5, 112.0))
+    assert outcome.status is StepStatus.OK, outcome.status
+    assert outcome.state.pose("b0")[0] == pytest.approx(120.0 - 0.5, abs=0.05)
+    assert outcome.sim_time > DEFAULT_SETTINGS.max_time
 
 
 def test_overlapping_approach_is_reported():
