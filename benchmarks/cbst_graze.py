@@ -6,14 +6,17 @@ Usage::
         [--cases 40] [--states 40] [--seed 0]
     python benchmarks/cbst_graze.py scenes [--scenes 300] [--states 50] [--controller servo]
     python benchmarks/cbst_graze.py plan [--problems blocks-3,blocks-4,blocks-7]
-        [--graze 1,0] [--farther-places] [--flush-within 0.07] [--controller servo]
+        [--graze 1,0] [--allowance inf] [--farther-places] [--flush-within 0.07]
+        [--controller servo]
         [--evaluate 1000] [--workers 2]
 
 A *grazed* block (docs/cbst.md, "The contact graph") is one a push may touch only with the
 corner of a neighbouring row sliding past, and is already flush. CBST keeps its box, extends it
 forward to where it would be flush, and widens it across the push on both sides by the overlap
 of the grazer's shadow box with its own (``contact_graph._shadow_overlap``), the most a corner
-sliding straight past can push it aside. Its angle box is kept.
+sliding straight past can push it aside, but by no more than the controller's grazing
+allowance (``arrange_up.transitions.cbst.GRAZE_ALLOWANCE``, measured by ``scenes``). Its angle
+box is kept.
 
 ``measure`` plans each problem with the shipped model of its controller
 (``plan(..., semantics="cbst")``, as ``arrange-up plan PROBLEM --semantics cbst`` does) and
@@ -37,7 +40,9 @@ with it beyond its predicted box by more than the slop, and by how much.
 ``plan`` plans each problem (300 s each) under variants, one row each:
 
 * ``--graze S``: the overlap bound scaled by ``S`` (1 is CBST's rule; 0 leaves a grazed block's
-  box unwidened across the push, which is *not* sound: a probe of what the bound costs);
+  box unwidened across the push, a probe of what the widening costs);
+* ``--allowance A``: the most a grazed block is widened across the push (CBST's
+  ``GRAZE_ALLOWANCE``, measured by ``scenes``, per controller); ``inf`` is the overlap alone;
 * ``--farther-places``: where no place of the 3 x 3 grid about a part's target is clear, also
   the places 2, 3 and 4 grid steps out along each of its offsets (the grid stops one step from
   the target, and a neighbour pressed into a corner under the compliant controller, its angle
@@ -83,7 +88,7 @@ from arrange_up.model.world import Place, Push, WorldState, draw_noise
 from arrange_up.physics.simulation import simulate
 from arrange_up.planning import actions
 from arrange_up.planning.planner import plan
-from arrange_up.transitions.cbst import CBSTSemantics
+from arrange_up.transitions.cbst import GRAZE_ALLOWANCE, CBSTSemantics
 
 #: The physics' contact slop: an outcome this far beyond a predicted box is inside it.
 SLOP = (0.005, 0.005, math.radians(0.5))
@@ -145,6 +150,20 @@ def graze_scale(scale: float) -> Iterator[None]:
         yield
     finally:
         contact_graph._shadow_overlap = original
+
+
+@contextlib.contextmanager
+def graze_allowance(allowance: float | None) -> Iterator[None]:
+    """Every controller's :data:`~arrange_up.transitions.cbst.GRAZE_ALLOWANCE` set to
+    ``allowance`` inches in this process (``inf``: the overlap alone, the rule before the
+    allowance; None: as shipped)."""
+    original = dict(GRAZE_ALLOWANCE)
+    if allowance is not None:
+        GRAZE_ALLOWANCE.update(dict.fromkeys(GRAZE_ALLOWANCE, allowance))
+    try:
+        yield
+    finally:
+        GRAZE_ALLOWANCE.update(original)
 
 
 @contextlib.contextmanager
@@ -300,6 +319,7 @@ def plan_variants(args: argparse.Namespace) -> None:
             problem = _problem(name, args.controller)
             with (
                 graze_scale(scale),
+                graze_allowance(args.allowance),
                 farther_places(args.farther_places),
                 flush_within(args.flush_within),
             ):
@@ -307,6 +327,8 @@ def plan_variants(args: argparse.Namespace) -> None:
             variant = f"graze x{scale:g}"
             if args.farther_places:
                 variant += ", farther places"
+            if args.allowance is not None:
+                variant += f", allowance {args.allowance:g} in"
             if args.flush_within is not None:
                 variant += f", flush within {args.flush_within:g} in"
             line = (
@@ -401,7 +423,8 @@ def scenes(args: argparse.Namespace) -> None:
     wall_push = "uniform" if args.controller == "servo" else "planner"
     settings = GenerationSettings(controller=controller, wall_push=wall_push)
     refused: dict[str, int] = {}
-    rows: list[tuple[str, float, list[float]]] = []  # kind, spread along the push, excess
+    # kind, spread along the push, excess beyond the predicted box, beyond the prior box across
+    rows: list[tuple[str, float, list[float], float]] = []
     for index in range(args.scenes):
         drawn = graze_scene(index, args.seed, settings)
         if drawn is None:
@@ -420,8 +443,9 @@ def scenes(args: argparse.Namespace) -> None:
         grazed = dict(cases[0].grazed) if cases else {}
         moved = post.get(neighbour) != belief.get(neighbour)
         kind = "grazed" if neighbour in grazed else ("pushed" if moved else "left alone")
-        predicted = post.get(neighbour)
+        predicted, prior = post.get(neighbour), belief.get(neighbour)
         excess = [0.0, 0.0, 0.0]
+        aside = 0.0  # how far the neighbour ended beyond its box before the push, across it
         starts = _scene_states(problem, belief, cfg, rng, args.states)
         for start in starts:
             state = WorldState.from_mapping(problem, start)
@@ -432,15 +456,25 @@ def scenes(args: argparse.Namespace) -> None:
             pose = (*end[:2], predicted.center[2] + _turn(end[2], predicted.center[2]))
             for i in range(3):
                 excess[i] = max(excess[i], predicted.low[i] - pose[i], pose[i] - predicted.high[i])
+            aside = max(aside, prior.low[1] - end[1], end[1] - prior.high[1])
         if not starts:
             continue
-        rows.append((kind, 2.0 * belief.get(neighbour).half[0], excess))
+        rows.append((kind, 2.0 * prior.half[0], excess, aside))
     print(
         f"{args.controller or 'compliant'}: {args.scenes} scenes; predicted {len(rows)}; "
         "not predicted: "
         + ", ".join(f"{k} {v}" for k, v in sorted(refused.items(), key=lambda kv: -kv[1])),
         flush=True,
     )
+    aside = np.array([r[3] for r in rows if r[0] == "grazed"])
+    if aside.size:
+        p95, p99 = np.percentile(aside, [95, 99])
+        print(
+            f"  grazed neighbours, how far beyond their box before the push they ended across "
+            f"it: 95th percentile {p95:.3f} in, 99th {p99:.3f} in, largest {aside.max():.3f} in "
+            f"({aside.size} scenes; the grazing allowance, docs/cbst.md)",
+            flush=True,
+        )
     for kind in ("grazed", "pushed", "left alone"):
         for limit in [*args.spreads, math.inf]:
             some = [r for r in rows if r[0] == kind and r[1] <= limit + 1e-9]
@@ -540,6 +574,14 @@ def main() -> None:
         action="store_true",
         help="where no grid place about a part's target is clear, also offer places 2-4 grid "
         "steps out",
+    )
+    p.add_argument(
+        "--allowance",
+        type=float,
+        default=None,
+        metavar="INCHES",
+        help="the most a grazed block is widened across the push, for every controller; inf "
+        "for the grazer's overlap alone (default: CBST's GRAZE_ALLOWANCE of the controller)",
     )
     p.add_argument(
         "--flush-within",

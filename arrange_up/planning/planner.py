@@ -444,7 +444,7 @@ def plan(
     statistics = dataclasses.replace(best.statistics, elapsed=time.monotonic() - started)
     return dataclasses.replace(
         best,
-        particles=particles,
+        particles=particles if research else best.particles,  # the requested, not the grown
         statistics=statistics,
         validation=Validation(
             validate,

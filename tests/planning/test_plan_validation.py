@@ -114,6 +114,7 @@ def test_validation_is_on_by_default_for_the_conformant_semantics(narrow) -> Non
     assert cbst.solved and cbst.validation is not None
     assert cbst.validation.rollouts == cbst.validation.run == 60
     assert [r.particles for r in cbst.validation.rounds] == [None]  # one round, no particles
+    assert cbst.particles == 2  # the interval belief's corners, as an unvalidated run says
     assert plan(narrow, semantics="deterministic").validation is None  # a nominal plan
     # a start belief is a posterior, not the initial uncertainty the rollouts draw from
     start = particles.beliefs[0]

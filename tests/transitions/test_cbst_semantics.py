@@ -19,7 +19,7 @@ from arrange_up.model.problem import Controller, ControllerKind, InitialObject
 from arrange_up.model.world import Pick, Place, Push, WorldState
 from arrange_up.planning.planner import plan
 from arrange_up.transitions import available, make_semantics
-from arrange_up.transitions.cbst import CBSTSemantics
+from arrange_up.transitions.cbst import GRAZE_ALLOWANCE, CBSTSemantics
 
 SERVO = Controller(kind=ControllerKind.SERVO)
 
@@ -191,6 +191,42 @@ def test_predicted_boxes_contain_simulated_outcomes():
             pose[2] -= math.pi / 4
             assert np.all(pose >= np.array(iv.low) - tol), (name, pose, iv)
             assert np.all(pose <= np.array(iv.high) + tol), (name, pose, iv)
+
+
+def test_a_grazed_block_is_widened_across_by_at_most_the_allowance(monkeypatch):
+    """A grazed block (C, flush in row 2, while B is pushed against A in row 1) is widened
+    across the push by the grazer's overlap, but by no more than the controller's allowance."""
+    problem = load("blocks-3")
+    half_c = (0.011281, 0.090993, 0.042396)
+    belief = IntervalBelief(
+        (
+            (
+                "A",
+                CBSTSemantics(problem)._interval(
+                    "A", (9.494504, 0.541542, 0.0), (0.011496, 0.041542, 0.043264)
+                ),
+            ),
+            (
+                "B",
+                CBSTSemantics(problem)._interval(
+                    "B", (8.088, 0.700916, 0.0), (0.287, 0.011916, 0.049)
+                ),
+            ),
+            ("C", CBSTSemantics(problem)._interval("C", (9.494719, 1.493477, 0.0), half_c)),
+        )
+    )
+    push = Push("paddle", (7.067304, 1.522212, -0.5 * math.pi), 2.8577)
+
+    def widened(allowance: float) -> float:
+        monkeypatch.setitem(GRAZE_ALLOWANCE, ControllerKind.SERVO, allowance)
+        post = CBSTSemantics(problem).apply(belief, push)
+        assert post is not None
+        return post.get("C").half[1] - half_c[1]
+
+    overlap = widened(math.inf)  # the grazer's overlap alone
+    assert overlap > 0.05
+    assert widened(0.05) == pytest.approx(0.05, abs=2e-6)
+    assert widened(1.0) == pytest.approx(overlap, abs=2e-6)
 
 
 def _simulate_plan(problem, actions, seed: int) -> WorldState | None:
