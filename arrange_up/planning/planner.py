@@ -12,7 +12,6 @@ import dataclasses
 import functools
 import math
 import time
-from collections import Counter
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -139,7 +138,9 @@ class PlanResult:
     ``unfit`` why each of them cannot (:func:`~arrange_up.planning.fitting.unfit_parts`: at no
     angle, or no pose, its goal allows), one clause each, in the problem's display units.
     ``refusals``: ``(reason, count)`` of the candidates the semantics refused, most frequent
-    first, for a semantics that says why (CBST's ``reasons``; empty otherwise).
+    first, for a semantics that says why (its ``reasons``: CBST's, and the particle and
+    deterministic semantics' failed simulations, such as a push that left a part off the table
+    or did not come to rest; empty otherwise).
     ``unplaceable`` (empty when solved): the parts off the table that have a place target at the
     search's start but no place candidate there, every one failing the place precondition
     (their shadow must keep clear of walls, obstacles and the parts on the table: a part that
@@ -570,7 +571,8 @@ def _search(
         statistics=statistics,
         beliefs=tuple(result.states) if result.states is not None else None,
         misses=misses,
-        refusals=tuple(getattr(task.semantics, "reasons", Counter()).most_common()),
+        # counted where each child was computed, this process or a worker (successors)
+        refusals=tuple(evaluator.reasons.most_common()),
         unplaceable=_unplaceable(task, start_belief, misses),
         unfit=tuple(u.why for u in unfit),
     )

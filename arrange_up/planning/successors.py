@@ -35,12 +35,17 @@ plans and statistics are identical for any worker count and backend. The problem
 each worker builds from it, travel to each worker once (a :class:`~arrange_up.parallel.Session`);
 a job carries a belief and an action. Pushes computed ahead that the search never asks for are
 wasted work (not in the run's statistics; :attr:`SuccessorEvaluator.sent` counts the jobs).
+
+Why a child has no prediction travels the same way as the simulations it took: a job's answer
+carries the reasons its semantics counted while computing it (its ``reasons``, as CBST's and
+the particle semantics' name them), and :attr:`SuccessorEvaluator.reasons` adds up those of
+the children the search asked for, the same for any runner.
 """
 
 from __future__ import annotations
 
 import threading
-from collections import deque
+from collections import Counter, deque
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -143,12 +148,14 @@ class _InProcess:
 class _Answer:
     """A job's result: the child (None: no prediction) and its heuristic value when asked
     for (``whole``), or a share's :class:`~arrange_up.transitions.particles.PushBatch`
-    (``share``); and the simulations run."""
+    (``share``); the simulations run, and the ``(reason, count)`` of the refusals the
+    semantics counted in its ``reasons`` meanwhile (empty for a semantics without them)."""
 
     child: Any
     h: float | None
     batch: Any
     simulations: int
+    reasons: tuple[tuple[str, int], ...] = ()
 
 
 def _work(context: Any, job: tuple[Any, ...]) -> _Answer:
@@ -158,14 +165,20 @@ def _work(context: Any, job: tuple[Any, ...]) -> _Answer:
         task = context.task()
         semantics = task.semantics
         before = semantics.simulations
+        counted: Counter[str] | None = getattr(semantics, "reasons", None)
+        known = Counter(counted) if counted else Counter()
         if job[0] == "whole":
             _, belief, action, with_h = job
             child = semantics.apply(belief, action)
             h = float(task.heuristic(child)) if with_h and child is not None else None
-            return _Answer(child, h, None, semantics.simulations - before)
-        _, belief, action, indices, affected = job
-        batch, _ = semantics.push_share(belief, action, indices, affected)
-        return _Answer(None, None, batch, semantics.simulations - before)
+            batch = None
+        else:
+            _, belief, action, indices, affected = job
+            batch, _ = semantics.push_share(belief, action, indices, affected)
+            child = h = None
+        # the refusals counted by this job alone (counts only grow)
+        reasons = tuple((counted - known).items()) if counted is not None else ()
+        return _Answer(child, h, batch, semantics.simulations - before, reasons)
 
 
 class _Child:
@@ -236,7 +249,7 @@ class _Child:
         self.done = True
         jobs, self.jobs = self.jobs, []
         first = jobs[0].result()
-        ev.simulations += first.simulations
+        ev.count(first)
         if self.shares is None:
             ev.last = (first.child, first.h)
             return first.child
@@ -259,7 +272,7 @@ class _Child:
             jobs[1].cancel()
             return DOMINATED
         second = jobs[1].result()
-        ev.simulations += second.simulations
+        ev.count(second)
         if not second.batch.ok:
             return None
         outcomes.update(zip(rest, second.batch.outcomes, strict=True))
@@ -273,8 +286,9 @@ class SuccessorEvaluator:
     ``spec`` is what the workers build their task from (ignored by a serial runner, which uses
     ``task``); ``index`` is the search's dominance index (None: no staged pushes).
     :attr:`simulations` counts the simulations of the children the search asked for, the
-    same for any runner; :attr:`sent` counts the jobs sent, among them those computed ahead
-    that the search never asked for.
+    same for any runner, and :attr:`reasons` why the semantics refused those it refused (its
+    ``reasons``, counted in whichever process computed them); :attr:`sent` counts the jobs
+    sent, among them those computed ahead that the search never asked for.
     """
 
     def __init__(
@@ -299,6 +313,7 @@ class SuccessorEvaluator:
         self.here: Session[tuple[Any, ...], _Answer] = SerialRunner().session(_work, here)
         self.session = runner.session(_work, spec) if self.ahead else self.here
         self.simulations = 0
+        self.reasons: Counter[str] = Counter()
         self.sent = 0
         self.last: tuple[Any, float | None] | None = None
         self._sent: deque[_Child] = deque()
@@ -341,6 +356,11 @@ class SuccessorEvaluator:
                 dropped.reset()
 
     # -- helpers ---------------------------------------------------------------------------------
+    def count(self, answer: _Answer) -> None:
+        """Add the simulations and the refusal reasons of an ``answer`` the search asked for."""
+        self.simulations += answer.simulations
+        self.reasons.update(dict(answer.reasons))
+
     def dominated(self, partial: ParticleBelief) -> bool:
         assert self.index is not None
         return self.index.dominated(partial, 0.0)

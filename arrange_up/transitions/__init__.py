@@ -49,6 +49,15 @@ class Semantics(Protocol):
         planner does not propose it. False for a learned prediction (CBST), which is a function
         of the belief (a repeat is a duplicate) and which needs such pushes to narrow intervals
         until later contacts are certain. A class that subclasses this protocol inherits True.
+
+    A semantics may also say why it refused transitions: ``reasons``, a
+    :class:`collections.Counter` of short human-readable sentences, one count per ``None``
+    that :meth:`apply` returned (CBST's "the push is not axis-aligned", the particle
+    semantics' "a push left A off the table", ...). The planner adds up the reasons counted
+    while computing the children the search asked for, in this process or in a worker
+    (:mod:`arrange_up.planning.successors`), and names the most frequent when a search ends
+    unsolved (:attr:`arrange_up.planning.planner.PlanResult.refusals`). It is optional: without
+    it the planner says only that the semantics gave no prediction.
     """
 
     name: str

@@ -28,13 +28,17 @@ for sideways drift) are collected; only those are simulated, the rest are copied
 push that reaches nothing returns the belief itself, without simulation.
 
 A transition is refused (``None``) when any particle's push fails: a part or fixture ends off
-the table, or the simulation does not come to rest within the cap. A conformant plan must not
-rely on such an action.
+the table, or the simulation does not come to rest within the cap, or the push starts with
+shapes overlapping. A conformant plan must not rely on such an action. ``reasons`` counts why,
+one short sentence per refused transition (:meth:`Simulated.refusal` of the first failed
+particle's push), for diagnostics: the planner names the most frequent in its reason line, as
+it does CBST's.
 """
 
 from __future__ import annotations
 
 import hashlib
+from collections import Counter
 from collections.abc import Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass
@@ -65,7 +69,7 @@ from arrange_up.model.world import (
 )
 from arrange_up.parallel import available_cores as default_workers  # noqa: F401  (its former name here)
 from arrange_up.parallel import local_executor
-from arrange_up.physics.simulation import StepStatus, simulate
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, StepStatus, simulate
 
 #: Extra reach of a push beyond its commanded distance, and sideways drift allowance (inches).
 SWEEP_MARGIN = 0.3
@@ -99,6 +103,31 @@ class Simulated(NamedTuple):
         if self.status == StepStatus.OVERLAP:
             return "a particle's push started with shapes overlapping"
         return f"a particle's push failed ({self.status})"
+
+    def refusal(self) -> str:
+        """Why a transition whose push failed so is refused: a short sentence for the planner's
+        reason line (a key of :attr:`ParticleSemantics.reasons`), naming the cause."""
+        if self.status == StepStatus.OFF_TABLE:
+            return f"a push left {', '.join(self.off_table)} off the table"
+        if self.status == StepStatus.NOT_AT_REST:
+            return NOT_AT_REST_REFUSAL
+        if self.status == StepStatus.OVERLAP:
+            return OVERLAP_REFUSAL
+        return f"a push failed in the simulation ({self.status})"
+
+
+#: :meth:`Simulated.refusal` of a push the simulation's time cap stopped
+#: (:attr:`~arrange_up.physics.settings.PhysicsSettings.max_time`, ``travel_margin``).
+NOT_AT_REST_REFUSAL = (
+    "a push did not come to rest within the simulation's time limit "
+    f"({DEFAULT_SETTINGS.max_time:g} s, or its travel time plus "
+    f"{DEFAULT_SETTINGS.travel_margin:g} s for a long push)"
+)
+#: :meth:`Simulated.refusal` of a push that started with shapes overlapping.
+OVERLAP_REFUSAL = (
+    "a push started with shapes overlapping (its approach pose or an earlier place put one "
+    "shape into another)"
+)
 
 
 @dataclass(frozen=True)
@@ -138,6 +167,8 @@ class ParticleSemantics:
         self.seed = seed
         self.workers = max(1, workers)
         self.simulations = 0
+        #: Why transitions were refused (:meth:`Simulated.refusal`), one count per refusal.
+        self.reasons: Counter[str] = Counter()
         self.frame = AngleFrame.of(problem)
         self.checker = CollisionChecker(problem)
         self._executor: Executor | None = None
@@ -195,7 +226,8 @@ class ParticleSemantics:
         [batch] = self.simulate_pushes([self.push_jobs(belief, push, affected, noises)])
         # the planner's statistic counts every particle's push, also those a failure cut short
         self.simulations += len(belief.particles)
-        if not batch.ok:
+        if batch.failure is not None:
+            self.reasons[batch.failure.refusal()] += 1
             return None
         return self.moved_particles(belief, batch.outcomes)
 
@@ -205,7 +237,8 @@ class ParticleSemantics:
         """Particles ``indices`` of ``belief`` pushed, simulating the ``affected`` objects (a
         share of :meth:`apply`'s work, for a push that reaches something): their
         :class:`PushBatch` and, when it is ok, the belief of those particles alone after the
-        push (the full child's rows at ``indices``).
+        push (the full child's rows at ``indices``). A failed share refuses the child: its
+        reason is counted in :attr:`reasons`, as :meth:`apply` counts it.
 
         Each particle's outcome is the one :meth:`apply` computes (its noise depends on its
         index and state only), so shares put together (:meth:`moved_particles` over every
@@ -216,7 +249,10 @@ class ParticleSemantics:
         noises = [self.noise(i, states[i], push) for i in indices]
         [batch] = self.simulate_pushes([self.push_jobs(share, push, affected, noises)])
         self.simulations += len(indices)  # counted as _push counts: the share's every particle
-        return batch, (self.moved_particles(share, batch.outcomes) if batch.ok else None)
+        if batch.failure is not None:
+            self.reasons[batch.failure.refusal()] += 1
+            return batch, None
+        return batch, self.moved_particles(share, batch.outcomes)
 
     def affected_objects(self, intervals: IntervalBelief, push: Push) -> frozenset[str]:
         """Objects the push may touch, directly or through others (a conservative sweep)."""

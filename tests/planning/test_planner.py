@@ -271,6 +271,43 @@ def test_an_exhausted_cbst_search_names_its_most_frequent_refusals():
     assert plan(servo(tiny("obstacle")), particles=5, workers=1).refusals == ()
 
 
+# A part to push flush with the open bottom edge of an unwalled table, by a paddle whose
+# stopping point along the push is uncertain by +-0.8 in: the push to the goal drives some
+# particle's part off the table, and it is the only candidate.
+OPEN_EDGE = """
+name: open-edge
+table: {size: [4, 3], walls: []}
+objects:
+  A: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+initial: {A: {pose: [2, 1.5, 0], uncertainty: [0.1, 0.1, 3]}}
+goal: {tolerance: [0.3, 0.3, 15], poses: {A: [2, 0.5, 0]}}
+uncertainty: {push: [0.2, 0.8, 2]}
+"""
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_an_exhausted_particle_search_names_why_its_pushes_were_refused(workers, monkeypatch):
+    problem, diagnostics = check_problem_text(OPEN_EDGE, "open-edge")
+    assert problem is not None and diagnostics == []
+    if workers > 1:
+        # every push is computed in a worker (a job is never taken back to compute it here,
+        # and this process's semantics refuses to push): the reasons travel back with it
+        from arrange_up import parallel
+
+        def here(*args, **kwargs):
+            raise AssertionError("a push was simulated in the planning process")
+
+        monkeypatch.setattr(parallel._LocalPending, "withdraw", lambda self: False)
+        monkeypatch.setattr(ParticleSemantics, "_push", here)
+        monkeypatch.setattr(ParticleSemantics, "push_share", here)
+    result = plan(problem, particles=10, workers=workers, validate=0)
+    assert result.status is SearchStatus.EXHAUSTED
+    assert result.statistics.no_prediction == 1
+    assert result.refusals == (("a push left A off the table", 1),)
+    assert "(no prediction; most often: 1 a push left A off the table)" in result.reason
+
+
 def test_a_goal_part_larger_than_the_table_is_proven_unsolvable_before_searching():
     problem, diagnostics = check_problem_text(TOO_LARGE, "too-large")
     assert problem is not None and [d.severity for d in diagnostics] == ["warning"]

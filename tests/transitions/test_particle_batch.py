@@ -4,12 +4,22 @@ keyed by the step alone."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from arrange_up.io.domains import load
 from arrange_up.model.world import Pick, Place, Push
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, StepStatus
 from arrange_up.planning.planner import plan
-from arrange_up.transitions.particles import ParticleSemantics, Simulated
+from arrange_up.transitions import particles
+from arrange_up.transitions.particles import (
+    NOT_AT_REST_REFUSAL,
+    OVERLAP_REFUSAL,
+    DeterministicSemantics,
+    ParticleSemantics,
+    Simulated,
+)
 
 
 @pytest.fixture(scope="module")
@@ -83,6 +93,36 @@ def test_a_failure_is_reported_and_stops_its_share():
     assert not bad.ok and bad.reason() == "a particle's push put A off the table"
     assert Simulated("not_at_rest", (), ()).reason() == "a particle's push did not come to rest"
     assert Simulated("ok", (), ()).ok
+
+
+def test_a_failed_push_says_why_its_transition_is_refused():
+    assert Simulated("off_table", ("A", "B"), ()).refusal() == "a push left A, B off the table"
+    assert Simulated("not_at_rest", (), ()).refusal() == NOT_AT_REST_REFUSAL
+    assert NOT_AT_REST_REFUSAL.startswith(
+        "a push did not come to rest within the simulation's time limit "
+        f"({DEFAULT_SETTINGS.max_time:g} s"
+    )
+    assert Simulated("overlap", (), ()).refusal() == OVERLAP_REFUSAL
+    assert Simulated("other", (), ()).refusal() == "a push failed in the simulation (other)"
+
+
+@pytest.mark.parametrize("kind", [ParticleSemantics, DeterministicSemantics])
+def test_a_refused_push_counts_its_reason(kind, blocks2, nominal, first_push, monkeypatch):
+    semantics = kind(blocks2, particles=4, seed=0)
+    belief = _before_push(semantics, nominal)
+    assert semantics.apply(belief, first_push) is not None and not semantics.reasons
+    real = particles.simulate
+
+    def capped(*args, **kwargs):  # every push hits the simulation's time cap
+        return dataclasses.replace(real(*args, **kwargs), status=StepStatus.NOT_AT_REST)
+
+    monkeypatch.setattr(particles, "simulate", capped)
+    assert semantics.apply(belief, first_push) is None
+    affected = semantics.affected_objects(belief.intervals, first_push)
+    batch, child = semantics.push_share(belief, first_push, [0], affected)
+    assert not batch.ok and child is None
+    # one reason per refusal: the share's first failure stops it
+    assert semantics.reasons == {NOT_AT_REST_REFUSAL: 2}
 
 
 def test_common_noise_is_keyed_by_the_step_alone(blocks2):
