@@ -7,6 +7,7 @@ settings are never mixed either)."""
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -51,5 +52,17 @@ def physics_setting(problems: Mapping[str, ArrangementProblem]) -> dict[str, dic
         for name, off in _LATER_SETTINGS_OFF.items():
             if values[name] == off:
                 del values[name]
+        if all(_short_pushes(p) for p in problems.values() if p.controller.kind is kind):
+            del values["travel_margin"]
         record[kind.value] = values
     return record
+
+
+def _short_pushes(problem: ArrangementProblem) -> bool:
+    """Whether no push of ``problem`` can outlast ``max_time - travel_margin`` at its push
+    speed (none is longer than the table's diagonal): then ``travel_margin``, a setting added
+    after CSVs were first recorded, changes none of its pushes and is left out of the record,
+    so that such rows still resume."""
+    s = DEFAULT_SETTINGS
+    speed = s.push_speed if problem.controller.speed is None else problem.controller.speed
+    return math.hypot(*problem.table.size) / speed <= s.max_time - s.travel_margin
