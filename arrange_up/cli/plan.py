@@ -185,7 +185,7 @@ def plan(
     """
     check_semantics(semantics)
     try:
-        check_validate(validate, semantics)
+        check_validate(validate)
     except ValueError as error:  # the message starts with the option's name
         fail(f"--{error}")
     backend = backend_choice(backend, scheduler)

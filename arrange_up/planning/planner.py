@@ -358,7 +358,7 @@ def plan(
         plans); 0 turns it off. A ``start`` belief (a posterior, not the problem's initial
         uncertainty) takes no validation: a positive value with one raises ``ValueError``.
     """
-    check_validate(validate, semantics, start)
+    check_validate(validate, start)
     if validate is None:
         validate = default_validation(semantics, particles, start)
     research = research_on_failure(semantics)

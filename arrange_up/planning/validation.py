@@ -96,12 +96,11 @@ def research_on_failure(semantics: str) -> bool:
     return semantics == "particles"
 
 
-def check_validate(validate: Any, semantics: str, start: Any = None) -> None:
+def check_validate(validate: Any, start: Any = None) -> None:
     """``ValueError`` unless ``validate`` suits a planning run (from a ``start`` belief when one
     is given): None (the default), or a non-negative integer that is positive only when
     planning from the problem's initial belief (the validation rollouts start from that belief,
-    not from a posterior). Every semantics takes it (``semantics`` is for the signature)."""
-    del semantics  # every semantics' plan can be checked on rollouts
+    not from a posterior). Every semantics' plan can be checked."""
     if validate is None:
         return
     if not isinstance(validate, int) or isinstance(validate, bool) or validate < 0:

@@ -568,7 +568,7 @@ def _check_params(
     if max_nodes is not None and not _positive(max_nodes):
         raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
     try:
-        check_validate(validate, semantics)
+        check_validate(validate)
     except ValueError as error:
         raise ValueError(f"arrange-up: {error}") from None
     if model is not None:
