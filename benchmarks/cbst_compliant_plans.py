@@ -143,22 +143,29 @@ def variant(args: argparse.Namespace, base: GenerationSettings, controller, angl
     for problem_name in PROBLEMS:
         problem = replace(load(problem_name), controller=controller)
         result = plan(problem, semantics="cbst", model=card_path, workers=1, timeout=300)
-        line = (
-            f"{name} {problem_name}: {result.status}, {result.stats['expanded']} nodes, "
-            f"{len(result.actions or ())} actions, {result.stats['elapsed']:.1f} s"
+        print(result_line(f"{name} {problem_name}", problem, result, args), flush=True)
+
+
+def result_line(label: str, problem, result, args: argparse.Namespace) -> str:
+    """One row for a planning ``result`` of ``problem``: status, nodes, plan length, search
+    seconds, the planner's reason when unsolved, and with ``args.evaluate`` the plan's score on
+    that many rollouts (seed 0, ``args.workers``)."""
+    line = (
+        f"{label}: {result.status}, {result.stats['expanded']} nodes, "
+        f"{len(result.actions or ())} actions, {result.stats['elapsed']:.1f} s"
+    )
+    if not result.solved:
+        line += f" ({result.reason})"
+    if args.evaluate and result.actions is not None:
+        score = evaluate_plan(
+            problem, result.actions, rollouts=args.evaluate, seed=0, workers=args.workers
         )
-        if not result.solved:
-            line += f" ({result.reason})"
-        if args.evaluate and result.actions is not None:
-            score = evaluate_plan(
-                problem, result.actions, rollouts=args.evaluate, seed=0, workers=args.workers
-            )
-            low, high = score.interval
-            line += (
-                f"; {score.successes} of {score.trials} rollouts reach the goal "
-                f"(Wilson {100 * low:.1f}-{100 * high:.1f} %)"
-            )
-        print(line, flush=True)
+        low, high = score.interval
+        line += (
+            f"; {score.successes} of {score.trials} rollouts reach the goal "
+            f"(Wilson {100 * low:.1f}-{100 * high:.1f} %)"
+        )
+    return line
 
 
 if __name__ == "__main__":

@@ -66,6 +66,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
+from cbst_compliant_plans import result_line  # this folder's: the scripts run from it
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.cbst import contact_graph
@@ -80,7 +81,6 @@ from arrange_up.cbst.data import (
     _squares_overlap,
 )
 from arrange_up.cbst.frame import CanonicalFrame
-from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.domains import load
 from arrange_up.model.problem import ArrangementProblem, Controller, ControllerKind, Uncertainty
@@ -331,23 +331,7 @@ def plan_variants(args: argparse.Namespace) -> None:
                 variant += f", allowance {args.allowance:g} in"
             if args.flush_within is not None:
                 variant += f", flush within {args.flush_within:g} in"
-            line = (
-                f"{variant} {name}: "
-                f"{result.status}, {result.stats['expanded']} nodes, "
-                f"{len(result.actions or ())} actions, {result.stats['elapsed']:.1f} s"
-            )
-            if not result.solved:
-                line += f" ({result.reason})"
-            if args.evaluate and result.actions is not None:
-                score = evaluate_plan(
-                    problem, result.actions, rollouts=args.evaluate, seed=0, workers=args.workers
-                )
-                low, high = score.interval
-                line += (
-                    f"; {score.successes} of {score.trials} rollouts reach the goal "
-                    f"(Wilson {100 * low:.1f}-{100 * high:.1f} %)"
-                )
-            print(line, flush=True)
+            print(result_line(f"{variant} {name}", problem, result, args), flush=True)
 
 
 def graze_scene(index: int, seed: int, settings: GenerationSettings):
@@ -503,18 +487,20 @@ def main() -> None:
         default=300,
         help="scenes drawn (default: %(default)s)",
     )
-    g.add_argument(
-        "--states",
-        type=int,
-        default=50,
-        help="states drawn from each scene's belief and simulated (default: %(default)s)",
-    )
-    g.add_argument(
-        "--seed",
-        type=int,
-        default=0,
-        help="seed of the scenes, states and noise (default: %(default)s)",
-    )
+    for sub, states, drawn in ((g, 50, "scenes"), (m, 40, "pushes")):
+        sub.add_argument(
+            "--states",
+            type=int,
+            default=states,
+            help=f"states drawn from the belief before each of the {drawn} and simulated "
+            "(default: %(default)s)",
+        )
+        sub.add_argument(
+            "--seed",
+            type=int,
+            default=0,
+            help=f"seed of the draws of {drawn}, states and noise (default: %(default)s)",
+        )
     g.add_argument(
         "--controller",
         choices=("compliant", "servo"),
@@ -549,18 +535,6 @@ def main() -> None:
         default=40,
         help="pushes with grazed blocks drawn from those the search predicted (default: "
         "%(default)s)",
-    )
-    m.add_argument(
-        "--states",
-        type=int,
-        default=40,
-        help="states drawn from the belief before each push and simulated (default: %(default)s)",
-    )
-    m.add_argument(
-        "--seed",
-        type=int,
-        default=0,
-        help="seed of the draws of pushes, states and noise (default: %(default)s)",
     )
     p.add_argument(
         "--graze",
