@@ -83,6 +83,7 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
             continue
         names.setdefault(key, path)
         _warn_unfit(shown, problem)
+        _warn_stiff(shown, problem)
         if not quiet:
             click.echo(
                 f"{shown}: ok: {problem.name} ({len(problem.parts)} "
@@ -106,6 +107,24 @@ def _warn_unfit(shown: str, problem: ArrangementProblem) -> None:
         where = "goal.relative" if problem.goal.is_relative else f"goal.poses.{unfit.part}"
         click.echo(
             f"{shown}: warning: {where}: {unfit.why}: no plan exists (plan answers unsolvable)",
+            err=True,
+        )
+
+
+def _warn_stiff(shown: str, problem: ArrangementProblem) -> None:
+    """Warn of each manipulator the compliant controller is too stiff for at the physics' time
+    step (:func:`arrange_up.physics.simulation.stiff_manipulators`): the file is valid, but its
+    simulated pushes oscillate and throw parts (a light, millimetre-scale paddle at the
+    default ``kp``)."""
+    from arrange_up.physics.simulation import STABLE_RATE, stiff_manipulators
+
+    for name, rate, kp_max in stiff_manipulators(problem):
+        click.echo(
+            f"{shown}: warning: controller: the compliant controller (kp "
+            f"{problem.controller.kp:g}) is too stiff for manipulator {name!r} at the "
+            f"physics' time step (sqrt(kp / m) x dt up to {rate:.2f}, stable below "
+            f"{STABLE_RATE:g}): its pushes oscillate and throw parts; give controller.kp at "
+            f"most {kp_max:.3g}, or kind: servo",
             err=True,
         )
 

@@ -232,6 +232,8 @@ __all__ = [
     "push_force",
     "simulate",
     "simulate_watched",
+    "stiff_manipulators",
+    "STABLE_RATE",
 ]
 
 
@@ -812,6 +814,45 @@ def compliant_gains(
     kd = zeta * math.sqrt(4.0 * mass * kp)
     kd_a = zeta * math.sqrt(4.0 * moment * kp_a)
     return kp, kd, kp_a, kd_a, force, torque, speed
+
+
+#: The largest ``sqrt(K / m) * dt`` (and ``sqrt(K_angle / I) * dt``) at which the compliant
+#: controller's explicitly integrated PD follows its set point (docs/problem-format.md,
+#: ``controller:``); beyond it the simulated paddle oscillates and parts are thrown.
+STABLE_RATE = 0.5
+
+
+def stiff_manipulators(
+    problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS
+) -> list[tuple[str, float, float]]:
+    """The manipulators the problem's compliant controller is too stiff for at the time step:
+    ``(name, rate, kp_max)``, ``rate`` the larger of ``sqrt(Kp / m) dt`` and
+    ``sqrt(Kp_angle / I) dt`` at the lightest manipulator density, above :data:`STABLE_RATE`,
+    and ``kp_max`` the largest ``kp`` (internal units) that keeps both at it when the angle
+    gain is its default ``kp r^2`` (with an explicit ``kp_angle``, the linear bound alone).
+    Empty under the servo."""
+    controller = problem.controller
+    if controller.kind is not ControllerKind.COMPLIANT:
+        return []
+    compiled = _compile(problem, settings.wall_thickness)
+    rho = problem.uncertainty.manipulator_density[0]
+    force = _force_clip(problem, compiled.parts_area, settings)
+    found = []
+    for spec in problem.manipulators:
+        body = compiled.bodies[spec.name]
+        mass = rho * body.area
+        moment = sum(rho * area * unit for area, unit in body.part_moments)
+        kp, _, kp_a, _, _, _, _ = compliant_gains(
+            controller, settings, mass, moment, body.radius, force
+        )
+        dt = settings.dt
+        rate = max(math.sqrt(kp / mass) * dt, math.sqrt(kp_a / moment) * dt)
+        if rate > STABLE_RATE:
+            limit = mass * (STABLE_RATE / dt) ** 2
+            if controller.kp_angle is None:
+                limit = min(limit, moment / body.radius**2 * (STABLE_RATE / dt) ** 2)
+            found.append((spec.name, rate, limit))
+    return found
 
 
 def _watched_step(watch: Callable[[list], None], bodies: list):
