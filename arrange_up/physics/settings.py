@@ -181,8 +181,9 @@ class PhysicsSettings:
         return max(1, math.ceil(self.max_time / self.dt - 1e-9))
 
     def cap_steps(self, setpoint_end: float) -> int:
-        """Steps a push may run whose set point reaches its end after ``setpoint_end`` seconds:
-        :attr:`max_steps`, or ``travel_margin`` after that end when it is later."""
+        """Steps a push may run whose set point reaches its end after ``setpoint_end`` seconds
+        (the simulation passes the time to cross the table at most): :attr:`max_steps`, or
+        ``travel_margin`` after that end when it is later."""
         return max(self.max_steps, math.ceil((setpoint_end + self.travel_margin) / self.dt))
 
 

@@ -200,6 +200,10 @@ def test_a_long_push_is_not_cut_off_before_it_could_arrive():
     assert outcome.status is StepStatus.OK, outcome.status
     assert outcome.state.pose("b0")[0] == pytest.approx(120.0 - 0.5, abs=0.05)
     assert outcome.sim_time > DEFAULT_SETTINGS.max_time
+    # ...but no longer than the time to cross the table: a plan file may command 1e300 in
+    endless = simulate(problem, state, push_east(10.0, 2.5, 1e300))
+    crossing = (math.hypot(120.0, 5.0) + 2.0 * math.hypot(1.25, 0.075)) / 3.0
+    assert endless.sim_time <= crossing + DEFAULT_SETTINGS.travel_margin + 0.1
 
 
 def test_overlapping_approach_is_reported():
