@@ -393,6 +393,8 @@ class _Builder:
         initial, obstacles = self.poses(values, kinds)
         goal = self.goal(kinds)
         self.check_put_away(kinds, {entry.name for entry in initial})
+        if goal is not None:
+            self.check_on_table(goal, kinds)
         if any(d.is_error for d in self.diagnostics):
             return None
         assert table is not None and uncertainty is not None and goal is not None
@@ -873,6 +875,32 @@ class _Builder:
                     f"such a fixture must end off it; expected (not (on-table {name})) or no "
                     "condition on it",
                 )
+
+    def check_on_table(self, goal: Goal, kinds: dict[str, ObjectKind]) -> None:
+        """An ``(on-table X)`` goal condition is kept only for a part the goal places (one with
+        pose intervals, or a relative goal's reference), which it restates. Anywhere else it
+        would ask for something the planner does not plan for (a part anywhere on the table, a
+        manipulator left on it): such a goal is refused rather than dropped, since a plan
+        ignoring it would be reported as reaching the goal."""
+        placed = set(goal.parts) | ({goal.reference} if goal.reference else set())
+        for condition, name in self.table_goals:
+            if condition != "on-table" or name in placed:
+                continue
+            kind = kinds.get(name)
+            why = (
+                f"{name} is a part without goal intervals: arrange-up plans for goal poses, "
+                f"(>= (x {name}) lo) (<= (x {name}) hi) and the same for y (and theta), and "
+                f"(on-table {name}) alone asks for none; give its intervals or drop the condition"
+                if kind is ObjectKind.PART
+                else f"{name} is {'not an object' if kind is None else f'a {kind.value}'}; a "
+                "goal places parts only (the manipulator is lifted off after every push), so "
+                "drop the condition"
+            )
+            self.error(
+                f"goal.{name}",
+                rf"\(\s*on-table\s+{re.escape(name)}\s*\)",
+                f"(on-table {name}): {why}",
+            )
 
     def check_goal_overlaps(self, problem: ArrangementProblem) -> None:
         """Parts that overlap at their nominal goal poses are a warning

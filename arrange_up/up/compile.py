@@ -46,8 +46,10 @@ Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl` and
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
+import re
 from collections.abc import Sequence
 from typing import Any
 
@@ -58,6 +60,7 @@ from unified_planning.plans import ActionInstance, SequentialPlan
 
 from arrange_up.belief.states import AngleFrame
 from arrange_up.io.pddl import problem_from_up
+from arrange_up.io.pddl_domain import domain_pddl_text
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Pick, Place, Push, nominal_initial_state
 from arrange_up.up.effects import (
@@ -311,8 +314,9 @@ def from_up(up_problem: Any) -> ArrangementProblem:
       the vocabulary. Names are as UP read them: lowercase, since PDDL is case-insensitive
       (:func:`arrange_up.io.pddl.load_pddl_problem` restores the written case from the file).
     * Anything else, refused with ``ValueError`` before any reading: a problem that is not a
-      plain UP ``Problem`` (scheduling, hierarchical, multi-agent, contingent, ...) or has a
-      feature outside :data:`READABLE_KIND`.
+      plain UP ``Problem`` (scheduling, hierarchical, multi-agent, contingent, ...), has a
+      feature outside :data:`READABLE_KIND`, or was read with another domain (its actions and
+      their parameter types are not the ``place``, ``push`` and ``pick`` of arrange-up's).
     """
     effect = _effect_of(up_problem)
     if effect is None:
@@ -345,6 +349,29 @@ def _check_readable(up_problem: Any) -> None:
             f"problem {up_problem.name!r} has features no arrange-up problem has: "
             f"{', '.join(outside)}"
         )
+    # The planner plans arrange-up's place, push and pick whatever actions the problem lists,
+    # so a problem read with another domain (an action renamed, removed or added) is refused:
+    # its plan would name actions that domain does not have.
+    actions = {a.name: tuple(p.type.name for p in a.parameters) for a in up_problem.actions}
+    expected = _domain_actions()
+    if actions != expected:
+        shown = ", ".join(f"{n}({', '.join(t)})" for n, t in sorted(actions.items()))
+        wanted = ", ".join(f"{n}({', '.join(t)})" for n, t in sorted(expected.items()))
+        raise ValueError(
+            f"problem {up_problem.name!r} was read with another domain than arrange-up's: its "
+            f"actions are {shown or 'none'}, expected {wanted} (read it with "
+            "arrange_up.io.pddl_domain.domain_path())"
+        )
+
+
+@functools.cache
+def _domain_actions() -> dict[str, tuple[str, ...]]:
+    """The actions of arrange-up's PDDL domain and their parameter types, from its text."""
+    pattern = r"\(:action\s+([\w-]+)\s+:parameters\s+\(([^)]*)\)"
+    return {
+        name: tuple(re.findall(r"-\s*([\w-]+)", parameters))
+        for name, parameters in re.findall(pattern, domain_pddl_text())
+    }
 
 
 # ---------------------------------------------------------------------------------------------

@@ -234,6 +234,24 @@ def test_the_goal_refuses_what_contradicts_the_put_away_rule():
         load_pddl_problem_text(kept, "dp.pddl")
 
 
+def test_an_on_table_goal_without_a_pose_is_refused_not_dropped():
+    # Dropped, B's (on-table B) left a goal of A alone, and a plan that never placed B was
+    # reported solved; a manipulator's, a goal no push keeps (the paddle is lifted off).
+    text = (domains_dir() / "blocks-2.pddl").read_text()
+    bare = re.sub(r"\(>= \(\w+ B\) [^)]*\)+ \(<= \(\w+ B\) [^)]*\)+\n", "", text)
+    assert "(x B)" not in bare.split("(:goal")[1] and "(on-table B)" in bare
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(bare, "b2.pddl")
+    (error,) = caught.value.errors
+    assert error.message.startswith("(on-table B): B is a part without goal intervals")
+    assert error.line == bare.splitlines().index("    (on-table B)") + 1
+    paddle = text.replace("    (on-table B)\n", "    (on-table B)\n    (on-table paddle)\n")
+    with pytest.raises(ProblemFormatError, match=r"\(on-table paddle\): paddle is a manipulator"):
+        load_pddl_problem_text(paddle, "b2.pddl")
+    # restating a goal part's place on the table is kept, as the shipped files do
+    assert load_pddl_problem_text(text, "b2.pddl").goal.parts == ("A", "B")
+
+
 def test_load_refuses_another_domain_and_a_missing_file(tmp_path: Path):
     text = (
         (domains_dir() / "blocks-1.pddl")

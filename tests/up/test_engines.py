@@ -84,6 +84,21 @@ def test_a_problem_read_from_pddl_is_solved():
     assert check.status is ValidationResultStatus.VALID
 
 
+@pytest.mark.parametrize(
+    ("old", "new"), [("(:action push", "(:action shove"), ("(:action pick", "(:action lift")]
+)
+def test_a_problem_read_with_another_domain_is_unsupported(tmp_path, old, new):
+    # its actions are not the ones the planner plans: a plan of push(...) would name an action
+    # the domain does not have
+    domain = tmp_path / "other-domain.pddl"
+    domain.write_text(domain_path().read_text().replace(old, new))
+    up = PDDLReader().parse_problem(str(domain), str(domains_dir() / "blocks-1.pddl"))
+    with pytest.warns(UserWarning, match="cannot establish whether arrange-up can solve"):
+        result = _solve(up)
+    assert result.status is Status.UNSUPPORTED_PROBLEM and result.plan is None
+    assert "was read with another domain than arrange-up's" in result.log_messages[0].message
+
+
 def test_a_foreign_problem_is_unsupported():
     from unified_planning.shortcuts import BoolType, Fluent, InstantaneousAction, Problem
 
