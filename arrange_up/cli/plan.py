@@ -240,9 +240,15 @@ def plan(
         echo_json(document_summary(document, output, plan_length=plan_length, reason=result.reason))
     else:
         stats = result.stats
+        # CBST's belief is an interval per object; its "2 particles" are the corner
+        # pseudo-particles the planner sees, nothing the user asked for
+        belief = (
+            "interval belief"
+            if result.semantics == "cbst"
+            else f"{result.particles} particle{'s' if result.particles != 1 else ''}"
+        )
         click.echo(
-            f"{loaded.name}: {result.status} ({result.semantics}, "
-            f"{result.particles} particle{'s' if result.particles != 1 else ''}, "
+            f"{loaded.name}: {result.status} ({result.semantics}, {belief}, "
             f"seed {seed}) in {stats['elapsed']:.1f} s: expanded {stats['expanded']}, "
             f"generated {stats['generated']}, "
             f"transitions simulated {stats['transitions_simulated']}"

@@ -538,10 +538,12 @@ class _Builder:
         }
         given: dict[str, set[int]] = {attr: set() for attr in fields}
         ok = True
+        stated: dict[str, set[int]] = {attr: set() for attr in given}  # refused values too
         for name, (attr, index) in NOISE_FUNCTIONS.items():
             value = values.get((name,))
             if value is None:
                 continue
+            stated[attr].add(index)
             density = "density" in name  # a body of zero mass cannot be simulated
             if value < 0 or (density and value == 0):
                 self.error(
@@ -561,7 +563,7 @@ class _Builder:
             given[attr].add(index)
         for attr in ("friction", "part_density", "manipulator_density"):
             stem = attr.replace("_", "-")
-            if len(given[attr]) == 1:
+            if len(stated[attr]) == 1:
                 self.error(
                     "init",
                     rf"\(\s*{stem}-(min|max)\s*\)",
@@ -569,7 +571,7 @@ class _Builder:
                     "uniform range) or neither (the default)",
                 )
                 ok = False
-            elif fields[attr][0] > fields[attr][1]:
+            elif len(given[attr]) == 2 and fields[attr][0] > fields[attr][1]:
                 self.error(
                     "init",
                     rf"\(\s*{stem}-min\s*\)",

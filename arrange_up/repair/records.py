@@ -148,7 +148,10 @@ class StepRecord:
         if self.kind != "push":
             return f"{self.kind} kept"
         units = problem.units
-        distance = f"distance {self.distance:.3f} (bare push {self.nominal_distance:.3f})"
+        # the score, not a push length: the mean distance of the outcomes from the nominal
+        # next state, the bare nominal push's beside it (None when that push was invalid)
+        bare = "invalid" if self.nominal_distance is None else f"{self.nominal_distance:.3f}"
+        distance = f"mean distance to the nominal state {self.distance:.3f} (bare push {bare})"
         if self.fixture is None or self.pose is None:
             return f"no fixture, x{self.multiplier:g}, {distance}"
         x, y, theta = units.pose_out(self.pose)

@@ -40,7 +40,8 @@ def test_a_cbst_plan_on_dask_starts_no_cluster(tmp_path, no_dask_runner):
     result = CliRunner().invoke(main, args)
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
     assert result.exit_code == 0, result.output
-    assert "solved" in result.output
+    assert "solved (cbst, interval belief, seed 0)" in result.output  # no "2 particles"
+    assert "validated on 60 fresh rollouts: 60 succeeded" in result.output
 
 
 def test_a_cbst_plan_does_not_reach_for_the_scheduler(tmp_path, no_dask_runner):

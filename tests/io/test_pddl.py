@@ -252,6 +252,17 @@ def test_an_on_table_goal_without_a_pose_is_refused_not_dropped():
     assert load_pddl_problem_text(text, "b2.pddl").goal.parts == ("A", "B")
 
 
+def test_a_refused_density_bound_is_the_one_error():
+    # both bounds are given; the one refused is not also reported as missing
+    text = (domains_dir() / "blocks-2.pddl").read_text()
+    zero = re.sub(r"\(= \(part-density-min\) [\d.]+\)", "(= (part-density-min) 0)", text)
+    assert zero != text
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(zero, "b2.pddl")
+    (error,) = caught.value.errors
+    assert error.message == "(part-density-min) is 0; expected a value > 0 (a density)"
+
+
 def test_load_refuses_another_domain_and_a_missing_file(tmp_path: Path):
     text = (
         (domains_dir() / "blocks-1.pddl")

@@ -541,3 +541,16 @@ def test_statuses_are_string_enums_and_statistics_a_dataclass(down_push, down_re
 def down_repair_scores(problem):
     nominal = rp.nominal_plans(problem, 1, seed=0)[0]
     return rp.step_scores(problem, nominal, 1, particles=4, seed=3).placements
+
+
+def test_a_choice_line_calls_its_score_a_mean_distance_not_a_push_length():
+    # "distance 0.198" beside a push of 4.1 in read as the push's length
+    from arrange_up.model.world import Push
+    from arrange_up.repair.records import StepRecord
+
+    push = Push("paddle", (1.0, 1.0, 0.0), 4.112)
+    record = StepRecord(0, "push", push, (push,), multiplier=1.0, distance=0.198)
+    line = record.describe_choice(load("blocks-1"))
+    assert line == "no fixture, x1, mean distance to the nominal state 0.198 (bare push invalid)"
+    bare = StepRecord(0, "push", push, (push,), multiplier=1.0, distance=0.2, nominal_distance=0.3)
+    assert bare.describe_choice(load("blocks-1")).endswith("state 0.200 (bare push 0.300)")
