@@ -507,7 +507,7 @@ class ArrangeUpPlanner(_Satisficing, _ArrangeUpEngine, OneshotPlannerMixin):
 
         metrics = {key: _short(value) for key, value in outcome.stats.items()}
         metrics.update(
-            status=outcome.status,
+            status=str(outcome.status),  # a plain string, as every metric is
             semantics=outcome.semantics,
             particles=str(outcome.particles),
             seed=str(outcome.seed),

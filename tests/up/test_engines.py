@@ -63,6 +63,7 @@ def test_node_limit_is_reported_honestly():
     assert result.plan is None
     assert "node limit of 1" in result.log_messages[0].message
     assert result.metrics["status"] == "node-limit"
+    assert all(type(value) is str for value in result.metrics.values())  # not an enum
 
 
 def test_the_engine_enforces_the_timeout():
