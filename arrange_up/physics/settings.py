@@ -86,9 +86,10 @@ class PhysicsSettings:
     whose set point reaches its end later than ``max_time - travel_margin`` at the push speed
     is capped ``travel_margin`` after that end instead (:meth:`cap_steps`)."""
     travel_margin: float = 10.0
-    """Simulated time (s) a long push gets after its set point's end: one longer than about
-    30 in at the default speed (a metre-scale problem's) could not arrive within ``max_time``
-    and ended ``NOT_AT_REST`` whatever happened; shorter pushes keep the ``max_time`` cap."""
+    """Simulated time (s) a long push gets after its set point's end (a set point ending after
+    ``max_time - travel_margin``, about 30 in at the default speed): a push beyond about 60 in
+    (a metre-scale problem's) could not arrive within ``max_time`` and ended ``NOT_AT_REST``
+    whatever happened; shorter pushes keep the ``max_time`` cap."""
     settle_steps: int = 2
     """Steps run after writing the state, before driving the manipulator: the thesis ran "a
     couple of time steps" so the engine builds its contact state first. The overlap check reads
