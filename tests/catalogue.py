@@ -153,6 +153,18 @@ uncertainty:
   push: [0.05, 0.05, 3]
   friction: [0.25, 0.55]
 """,
+    # A millimetre-scale chip and an 8 x 0.5 mm paddle (mass about 0.0025): the compliant
+    # controller's default kp is far too stiff for it (physics.simulation.stiff_manipulators).
+    "millimetre-paddle": """
+name: millimetre-paddle
+units: {length: mm}
+table: {size: [40, 20]}
+objects:
+  chip: {kind: part, shape: {box: [5, 3]}}
+  tip: {kind: manipulator, shape: {box: [8, 0.5]}}
+initial: {chip: {pose: [20, 10, 0], uncertainty: [0.5, 0.5, 5]}}
+goal: {tolerance: [0.5, 0.5, 10], poses: {chip: [37.5, 1.5, 0]}}
+""",
 }
 
 NAMES: tuple[str, ...] = tuple(TEXTS)

@@ -8,6 +8,7 @@ import sys
 import textwrap
 
 import pytest
+from catalogue import text
 from click.testing import CliRunner
 
 from arrange_up.cli import main
@@ -73,23 +74,9 @@ def test_check_valid_shipped_file_by_path():
 def test_check_warns_of_a_controller_too_stiff_for_the_paddle(tmp_path):
     # valid to the format, but the default kp makes an 8 x 0.5 mm paddle's PD unstable
     tiny = tmp_path / "tiny.yaml"
-    tiny.write_text(
-        textwrap.dedent(
-            """\
-            format: arrange-up/1
-            name: tiny
-            units: {length: mm}
-            table: {size: [40, 20]}
-            objects:
-              chip: {kind: part, shape: {box: [5, 3]}}
-              tip: {kind: manipulator, shape: {box: [8, 0.5]}}
-            initial: {chip: {pose: [20, 10, 0], uncertainty: [0.5, 0.5, 5]}}
-            goal: {tolerance: [0.5, 0.5, 10], poses: {chip: [37.5, 1.5, 0]}}
-            """
-        )
-    )
+    tiny.write_text(text("millimetre-paddle"))
     result = run("check", str(tiny))
-    assert result.exit_code == 0 and "ok: tiny" in result.output
+    assert result.exit_code == 0 and "ok: millimetre-paddle" in result.output
     assert f"{tiny}: warning: controller: the compliant controller (kp 300) is too stiff" in (
         result.output
     )

@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import catalogue
 import numpy as np
 import pytest
 
@@ -466,26 +467,12 @@ def test_a_chattering_press_into_a_wall_ends_its_drive_once_stalled():
     assert abs(th) < 0.02
 
 
-TINY = """\
-format: arrange-up/1
-name: tiny
-units: {length: mm}
-table: {size: [40, 20]}
-objects:
-  chip: {kind: part, shape: {box: [5, 3]}}
-  tip: {kind: manipulator, shape: {box: [8, 0.5]}}
-initial: {chip: {pose: [20, 10, 0], uncertainty: [0.5, 0.5, 5]}}
-goal: {tolerance: [0.5, 0.5, 10], poses: {chip: [37.5, 1.5, 0]}}
-"""
-
-
 def test_a_controller_too_stiff_for_a_light_paddle_is_named_with_the_gain_that_is_not():
     # An 8 x 0.5 mm paddle weighs about 0.0025: the default kp of 300 is far beyond what the
     # explicitly integrated PD follows at 1/240 s, and its pushes throw the chip off the table.
-    from arrange_up.io.yaml_problem import load_problem_text
     from arrange_up.physics.simulation import STABLE_RATE, stiff_manipulators
 
-    tiny = load_problem_text(TINY, "tiny.yaml")
+    tiny = catalogue.tiny("millimetre-paddle")
     [(name, rate, kp_max)] = stiff_manipulators(tiny)
     assert name == "tip" and rate > 2 * STABLE_RATE and 1.0 < kp_max < 300.0
     at_limit = dataclasses.replace(tiny, controller=dataclasses.replace(tiny.controller, kp=kp_max))
