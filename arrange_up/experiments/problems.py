@@ -7,13 +7,12 @@ settings are never mixed either)."""
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from arrange_up.io.domains import load
 from arrange_up.model.problem import ArrangementProblem, driven_by
-from arrange_up.physics.settings import DEFAULT_SETTINGS
+from arrange_up.physics.settings import DEFAULT_SETTINGS, push_crossing
 
 __all__ = ["controller_setting", "driven_problems", "physics_setting"]
 
@@ -60,9 +59,14 @@ def physics_setting(problems: Mapping[str, ArrangementProblem]) -> dict[str, dic
 
 def _short_pushes(problem: ArrangementProblem) -> bool:
     """Whether no push of ``problem`` can outlast ``max_time - travel_margin`` at its push
-    speed (none is longer than the table's diagonal): then ``travel_margin``, a setting added
-    after CSVs were first recorded, changes none of its pushes and is left out of the record,
-    so that such rows still resume."""
+    speed (none travels further than :func:`~arrange_up.physics.settings.push_crossing`, as the
+    simulation bounds it): then ``travel_margin``, a setting added after CSVs were first
+    recorded, changes none of its pushes and is left out of the record, so that such rows
+    still resume."""
     s = DEFAULT_SETTINGS
     speed = s.push_speed if problem.controller.speed is None else problem.controller.speed
-    return math.hypot(*problem.table.size) / speed <= s.max_time - s.travel_margin
+    longest = max(
+        (push_crossing(problem.table.size, spec.shape.radius) for spec in problem.manipulators),
+        default=0.0,
+    )
+    return longest / speed <= s.max_time - s.travel_margin

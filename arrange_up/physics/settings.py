@@ -16,6 +16,7 @@ __all__ = [
     "SERVO_VALUES",
     "PhysicsSettings",
     "pd_gains",
+    "push_crossing",
     "push_force",
 ]
 
@@ -234,6 +235,14 @@ fields."""
 DEFAULT_SETTINGS = PhysicsSettings()
 """The defaults: the settling and rest fields ``None``, so that each push takes its
 controller's (:data:`CONTROLLER_VALUES`)."""
+
+
+def push_crossing(table_size: tuple[float, float], radius: float) -> float:
+    """The longest travel a push can make on a table of ``table_size`` with a manipulator of
+    ``radius`` before it ends against a wall or off the table (inches): the diagonal, plus the
+    manipulator on either side. The long-push cap makes room for this much at most
+    (:meth:`PhysicsSettings.cap_steps`)."""
+    return math.hypot(*table_size) + 2.0 * radius
 
 
 def push_force(problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS) -> float:

@@ -219,6 +219,7 @@ from arrange_up.physics.settings import (
     PhysicsSettings,
     _force_clip,
     pd_gains,
+    push_crossing,
     push_force,
 )
 
@@ -584,11 +585,12 @@ def _push(
 
         interval = s.interval_steps
         speed = s.push_speed if controller.speed is None else controller.speed
-        setpoint_end = distance / (track.speed if compliant else speed)
+        speed = track.speed if compliant else speed
+        setpoint_end = distance / speed
         # The cap makes room for the travel across the table at most: a push commanded further
         # (a plan file may say 1e300 in) ends against a wall or off the table by then.
-        crossing = math.hypot(*compiled.table.size) + 2.0 * paddle_def.radius
-        max_steps = s.cap_steps(min(distance, crossing) / (track.speed if compliant else speed))
+        crossing = push_crossing(compiled.table.size, paddle_def.radius)
+        max_steps = s.cap_steps(min(distance, crossing) / speed)
         lin2 = s.rest_linear_tol * s.rest_linear_tol
         ang_tol = s.rest_angular_tol
         need = s.rest_checks
