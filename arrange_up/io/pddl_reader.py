@@ -362,7 +362,7 @@ class _Builder:
     located: _Text | None
     diagnostics: list[Diagnostic] = field(default_factory=list)
     #: The goal's ``(on-table X)`` and ``(not (on-table X))`` conditions, as
-    #: ``("on-table" | "off-table", X)`` (:meth:`check_put_away`).
+    #: ``("on-table" | "off-table", X)`` (:meth:`check_table_goals`).
     table_goals: list[tuple[str, str]] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -392,9 +392,7 @@ class _Builder:
         uncertainty = self.uncertainty(values)
         initial, obstacles = self.poses(values, kinds)
         goal = self.goal(kinds)
-        self.check_put_away(kinds, {entry.name for entry in initial})
-        if goal is not None:
-            self.check_on_table(goal, kinds)
+        self.check_table_goals(kinds, {entry.name for entry in initial}, goal)
         if any(d.is_error for d in self.diagnostics):
             return None
         assert table is not None and uncertainty is not None and goal is not None
@@ -847,14 +845,24 @@ class _Builder:
         )
         return None
 
-    def check_put_away(self, kinds: dict[str, ObjectKind], initial: set[str]) -> None:
-        """The goal's ``(not (on-table F))`` states the format's rule that a fixture starting
-        off the table ends off it (the rule holds whether the goal states it or not): it may
-        name only such a fixture, and no ``(on-table F)`` may contradict the rule."""
+    def check_table_goals(
+        self, kinds: dict[str, ObjectKind], initial: set[str], goal: Goal | None
+    ) -> None:
+        """The goal's ``(on-table X)`` and ``(not (on-table X))`` conditions, one error each
+        where they ask for what the planner does not plan for.
+
+        ``(not (on-table F))`` states the format's rule that a fixture starting off the table
+        ends off it (the rule holds whether the goal states it or not): it may name only such a
+        fixture, and no ``(on-table F)`` may contradict the rule. ``(on-table X)`` is kept only
+        for a part the goal places (one with pose intervals, or a relative goal's reference),
+        which it restates; anywhere else (a part anywhere on the table, a manipulator left on
+        it) it is refused rather than dropped, since a plan ignoring it would be reported as
+        reaching the goal (not judged while the goal itself has errors: ``goal`` is None)."""
+        placed = set() if goal is None else {*goal.parts, goal.reference}
         for condition, name in self.table_goals:
-            put_away = kinds.get(name) is ObjectKind.FIXTURE and name not in initial
+            kind = kinds.get(name)
+            put_away = kind is ObjectKind.FIXTURE and name not in initial
             if condition == "off-table" and not put_away:
-                kind = kinds.get(name)
                 what = (
                     "not an object"
                     if kind is None
@@ -869,35 +877,27 @@ class _Builder:
                     "table only a fixture that starts off it (and every such fixture must end "
                     "off it, stated or not)",
                 )
-            elif condition == "on-table" and put_away:
-                self.error(
-                    f"goal.{name}",
-                    rf"\(\s*on-table\s+{re.escape(name)}\s*\)",
-                    f"(on-table {name}): {name} is a fixture that starts off the table, and "
-                    f"such a fixture must end off it; expected (not (on-table {name})) or no "
-                    "condition on it",
-                )
-
-    def check_on_table(self, goal: Goal, kinds: dict[str, ObjectKind]) -> None:
-        """An ``(on-table X)`` goal condition is kept only for a part the goal places (one with
-        pose intervals, or a relative goal's reference), which it restates. Anywhere else it
-        would ask for something the planner does not plan for (a part anywhere on the table, a
-        manipulator left on it): such a goal is refused rather than dropped, since a plan
-        ignoring it would be reported as reaching the goal."""
-        placed = set(goal.parts) | ({goal.reference} if goal.reference else set())
-        for condition, name in self.table_goals:
-            if condition != "on-table" or name in placed:
                 continue
-            kind = kinds.get(name)
-            why = (
-                f"{name} is a part without goal intervals: arrange-up plans for goal poses, "
-                f"(>= (x {name}) lo) (<= (x {name}) hi) and the same for y (and theta), and "
-                f"(on-table {name}) alone asks for none; give its intervals or drop the condition"
-                if kind is ObjectKind.PART
-                else f"{name} is {'not an object' if kind is None else f'a {kind.value}'}; a "
-                "goal places parts only (the manipulator is lifted off after every push), so "
-                "drop the condition"
-            )
+            if condition != "on-table":
+                continue
+            if put_away:
+                why = (
+                    f"{name} is a fixture that starts off the table, and such a fixture must "
+                    f"end off it; expected (not (on-table {name})) or no condition on it"
+                )
+            elif goal is None or name in placed:
+                continue
+            elif kind is ObjectKind.PART:
+                why = (
+                    f"{name} is a part without goal intervals: arrange-up plans for goal "
+                    f"poses, (>= (x {name}) lo) (<= (x {name}) hi) and the same for y (and "
+                    f"theta), and (on-table {name}) alone asks for none; give its intervals or "
+                    "drop the condition"
+                )
+            else:
+                lifted = " (lifted off after every push)" if kind is ObjectKind.MANIPULATOR else ""
+                what = "not an object" if kind is None else f"a {kind.value}{lifted}"
+                why = f"{name} is {what}; a goal places parts only, so drop the condition"
             self.error(
                 f"goal.{name}",
                 rf"\(\s*on-table\s+{re.escape(name)}\s*\)",

@@ -232,6 +232,10 @@ def test_the_goal_refuses_what_contradicts_the_put_away_rule():
     kept = text.replace("(not (on-table bar))", "(on-table bar)")
     with pytest.raises(ProblemFormatError, match=r"\(on-table bar\): bar is a fixture that starts"):
         load_pddl_problem_text(kept, "dp.pddl")
+    # one error for the one condition (not also "a goal places parts only")
+    with pytest.raises(ProblemFormatError) as caught:
+        load_pddl_problem_text(kept, "dp.pddl")
+    assert len(caught.value.errors) == 1
 
 
 def test_an_on_table_goal_without_a_pose_is_refused_not_dropped():
