@@ -25,12 +25,27 @@ from arrange_up.up.registration import ENGINES, up_ini
 
 def install(path: Path) -> bool:
     """Add the engines' sections to the configuration file ``path`` (created if missing);
-    False when it already names every engine (nothing is written)."""
+    False when it already names every engine where it is defined (nothing is written).
+
+    A file that names some of the engines, or names one with a module or class that does not
+    define it (one written before the engines moved), is not edited: ``SystemExit`` says what
+    to change by hand."""
     present = configparser.ConfigParser()
     if path.exists():
         present.read(path, encoding="utf-8")
     missing = [name for name, _, _ in ENGINES if not present.has_section(f"engine {name}")]
     if not missing:
+        stale = [
+            name
+            for name, module_name, class_name in ENGINES
+            if present.get(f"engine {name}", "module_name", fallback=None) != module_name
+            or present.get(f"engine {name}", "class_name", fallback=None) != class_name
+        ]
+        if stale:
+            raise SystemExit(
+                f"{path} names {', '.join(stale)} with another module or class than the one "
+                "defining it: edit it by hand (python -m arrange_up.up prints the sections)"
+            )
         return False
     if len(missing) < len(ENGINES):
         raise SystemExit(

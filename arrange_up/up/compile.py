@@ -41,7 +41,8 @@ silently mapped back to the original); for one read by UP's ``PDDLReader`` by re
 the PDDL vocabulary (:mod:`arrange_up.io.pddl`).
 
 Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl` and
-:mod:`arrange_up.up.engines` import unified-planning.
+the engines' modules (:mod:`arrange_up.up.engine_base`, :mod:`~arrange_up.up.engine_io` and one
+module per engine) import unified-planning.
 """
 
 from __future__ import annotations

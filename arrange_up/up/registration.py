@@ -4,7 +4,8 @@ unified-planning (1.3) has no entry points: its factory knows an engine from the
 table ``DEFAULT_ENGINES`` (name -> module and class names), read when a factory is made, or from
 ``Factory.add_engine(name, module, class)`` on a factory that exists; either way the factory
 imports the module and takes the class from it. arrange-up's engine classes are defined in
-:mod:`arrange_up.up.engines`, which imports unified-planning; this module only names them
+:mod:`arrange_up.up.planner_engine`, :mod:`~arrange_up.up.validator_engine` and
+:mod:`~arrange_up.up.repairer_engine`, which import unified-planning; this module only names them
 (:data:`ENGINES`) and, through :func:`register`, tells unified-planning where they are.
 
 ``import arrange_up`` calls :func:`register`. That must not import unified-planning, whose
@@ -25,30 +26,35 @@ from typing import Any
 
 __all__ = [
     "ENGINES",
-    "ENGINES_MODULE",
     "ENGINE_CLASS",
+    "ENGINE_MODULE",
     "ENGINE_NAME",
     "REPAIRER_CLASS",
+    "REPAIRER_MODULE",
     "REPAIRER_NAME",
     "VALIDATOR_CLASS",
+    "VALIDATOR_MODULE",
     "VALIDATOR_NAME",
     "register",
     "up_ini",
 ]
 
-#: The module that defines the engine classes (it imports unified-planning).
-ENGINES_MODULE = "arrange_up.up.engines"
+# Each engine's name in unified-planning's factory, and the module (one per engine; each imports
+# unified-planning) and class that define it.
 ENGINE_NAME = "arrange-up"
+ENGINE_MODULE = "arrange_up.up.planner_engine"
 ENGINE_CLASS = "ArrangeUpPlanner"
 VALIDATOR_NAME = "arrange-up-reliability"
+VALIDATOR_MODULE = "arrange_up.up.validator_engine"
 VALIDATOR_CLASS = "ArrangeUpReliability"
 REPAIRER_NAME = "arrange-up-fixtures"
+REPAIRER_MODULE = "arrange_up.up.repairer_engine"
 REPAIRER_CLASS = "ArrangeUpFixtureRepairer"
 #: Every engine the package registers: (name in unified-planning's factory, module, class).
 ENGINES: tuple[tuple[str, str, str], ...] = (
-    (ENGINE_NAME, ENGINES_MODULE, ENGINE_CLASS),
-    (VALIDATOR_NAME, ENGINES_MODULE, VALIDATOR_CLASS),
-    (REPAIRER_NAME, ENGINES_MODULE, REPAIRER_CLASS),
+    (ENGINE_NAME, ENGINE_MODULE, ENGINE_CLASS),
+    (VALIDATOR_NAME, VALIDATOR_MODULE, VALIDATOR_CLASS),
+    (REPAIRER_NAME, REPAIRER_MODULE, REPAIRER_CLASS),
 )
 
 _FACTORY_MODULE = "unified_planning.engines.factory"
@@ -105,7 +111,7 @@ def up_ini() -> str:
 
 def _add_to_defaults(factory_module: Any) -> None:
     """Add the engines to the default tables of unified-planning's factory module, which every
-    new ``Factory`` reads (importing :data:`ENGINES_MODULE` then)."""
+    new ``Factory`` reads (importing the engines' modules then)."""
     defaults = getattr(factory_module, "DEFAULT_ENGINES", None)
     preference = getattr(factory_module, "DEFAULT_ENGINES_PREFERENCE_LIST", None)
     for name, module_name, class_name in ENGINES:

@@ -467,9 +467,9 @@ def test_cli_without_dask_says_how_to_install_it(plan_file, monkeypatch):
 
 # -- the unified-planning validator -----------------------------------------------------------
 def test_the_reliability_validator(blocks1):
-    import arrange_up.up.engines as engines
+    from arrange_up.up.registration import register
 
-    engines.register()
+    register()
     from unified_planning.engines.results import ValidationResultStatus
     from unified_planning.environment import get_environment
     from unified_planning.shortcuts import PlanValidator

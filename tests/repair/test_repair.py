@@ -495,10 +495,10 @@ def test_up_plan_repairer(down_push):
     from unified_planning.engines import PlanGenerationResultStatus as Status
     from unified_planning.shortcuts import PlanRepairer
 
-    import arrange_up.up.engines as engines
     from arrange_up.up.compile import plan_from_up, plan_to_up, to_up
+    from arrange_up.up.registration import register
 
-    engines.register()
+    register()
     problem = to_up(down_push)
     nominal = plan_to_up(problem, rp.nominal_plans(down_push, 1, seed=0)[0])
     with PlanRepairer(name="arrange-up-fixtures", params={"particles": 4, "seed": 1}) as repairer:

@@ -19,14 +19,16 @@ from unified_planning.plans import SequentialPlan
 from unified_planning.shortcuts import OneshotPlanner, PlanRepairer, PlanValidator
 from unified_planning.test.examples import get_example_problems
 
-import arrange_up.up.engines as engines
+import arrange_up.up.engine_io as engine_io
+import arrange_up.up.repairer_engine as repairer_engine
 from arrange_up.io.domains import domains_dir, load
 from arrange_up.io.pddl import domain_path
 from arrange_up.planning.planner import plan
 from arrange_up.repair import repair_plan
 from arrange_up.up.compile import plan_from_up, plan_to_up, to_up
+from arrange_up.up.registration import register
 
-engines.register()
+register()
 ROOT = Path(__file__).resolve().parents[2]
 FAST_REPAIR = {"particles": 4, "seed": 1}
 
@@ -99,7 +101,7 @@ def test_a_repair_that_misses_the_goal_nominally_is_not_returned(blocks1, monkey
         outcome = real(*args, **kwargs)
         return replace(outcome, actions=outcome.actions[:-1])
 
-    monkeypatch.setattr(engines, "repair_plan", short_of_the_goal)
+    monkeypatch.setattr(repairer_engine, "repair_plan", short_of_the_goal)
     result = _repair(up_problem, plan_to_up(up_problem, nominal))
     assert result.status is Status.UNSOLVABLE_INCOMPLETELY
     assert result.plan is None and result.metrics["status"] == "missed-goal"
@@ -179,7 +181,7 @@ def test_an_unreadable_problem_is_reported_not_raised(monkeypatch):
     def broken(problem):
         raise TypeError("a reader defect")
 
-    monkeypatch.setattr(engines, "from_up", broken)
+    monkeypatch.setattr(engine_io, "from_up", broken)
     with OneshotPlanner(name="arrange-up") as planner:
         result = planner.solve(to_up(load("blocks-1")))
     assert result.status is Status.INTERNAL_ERROR
@@ -241,3 +243,15 @@ def test_installing_the_configuration_is_idempotent(tmp_path):
     text = path.read_text(encoding="utf-8")
     assert text.startswith("[engine other]") and text.endswith(up_ini())
     assert text.count("[engine arrange-up]") == 1
+
+
+def test_installing_over_sections_naming_another_module_says_what_to_edit(tmp_path):
+    from arrange_up.up.__main__ import install
+    from arrange_up.up.registration import up_ini
+
+    path = tmp_path / "up.ini"
+    moved = up_ini().replace("arrange_up.up.validator_engine", "arrange_up.up.engines")
+    path.write_text(moved, encoding="utf-8")
+    with pytest.raises(SystemExit, match="names arrange-up-reliability with another module"):
+        install(path)
+    assert path.read_text(encoding="utf-8") == moved

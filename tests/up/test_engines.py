@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import io
 import pickle
 import runpy
@@ -21,14 +22,16 @@ from unified_planning.io import PDDLReader
 from unified_planning.model import ProblemKind
 from unified_planning.shortcuts import OneshotPlanner, PlanRepairer, PlanValidator
 
-import arrange_up.up.engines as engines
 import arrange_up.up.registration as registration
 from arrange_up.io.domains import domains_dir, load
 from arrange_up.io.pddl import domain_path
 from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.up.compile import from_up, to_up
+from arrange_up.up.planner_engine import ArrangeUpPlanner
+from arrange_up.up.repairer_engine import ArrangeUpFixtureRepairer
+from arrange_up.up.validator_engine import ArrangeUpReliability
 
-engines.register()  # idempotent; works before or after unified_planning is imported
+registration.register()  # idempotent; works before or after unified_planning is imported
 
 DETERMINISTIC = {"semantics": "deterministic", "seed": 0}
 ROLLOUTS = {"rollouts": 8, "seed": 0, "workers": 1}
@@ -164,20 +167,20 @@ def test_a_particle_plan_reports_its_validation():
 
 
 def test_registration_is_idempotent():
-    engines.register()
-    engines.register()
+    registration.register()
+    registration.register()
     factory = get_environment().factory
     assert factory.engines.count("arrange-up") == 1
-    cls = engines.ArrangeUpPlanner
+    cls = ArrangeUpPlanner
     assert cls.supports(to_up(load("blocks-1")).kind)
     planner = cls()
     assert planner.name == "arrange-up"
 
 
 ENGINE_CLASSES = {
-    "arrange-up": engines.ArrangeUpPlanner,
-    "arrange-up-reliability": engines.ArrangeUpReliability,
-    "arrange-up-fixtures": engines.ArrangeUpFixtureRepairer,
+    "arrange-up": ArrangeUpPlanner,
+    "arrange-up-reliability": ArrangeUpReliability,
+    "arrange-up-fixtures": ArrangeUpFixtureRepairer,
 }
 
 
@@ -234,7 +237,7 @@ def test_selection_by_kind_never_picks_arrange_up_for_a_classical_problem():
 
 
 def test_the_planner_and_the_repairer_are_satisficing_not_optimal():
-    for cls in (engines.ArrangeUpPlanner, engines.ArrangeUpFixtureRepairer):
+    for cls in (ArrangeUpPlanner, ArrangeUpFixtureRepairer):
         assert cls.satisfies(OptimalityGuarantee.SATISFICING)
         assert not cls.satisfies(OptimalityGuarantee.SOLVED_OPTIMALLY)
     problem = to_up(load("blocks-1"))
@@ -272,7 +275,8 @@ _IMPORT_ORDERS = {
         "import sys\n"
         "import arrange_up\n"
         "assert 'unified_planning' not in sys.modules, 'import arrange_up imported UP'\n"
-        "assert 'arrange_up.up.engines' not in sys.modules, 'import arrange_up imported engines'\n"
+        "loaded = [m for m in sys.modules if m.startswith('arrange_up.up.')]\n"
+        "assert loaded == ['arrange_up.up.registration'], loaded\n"
         "from unified_planning.shortcuts import OneshotPlanner, get_environment\n"
     ),
     "unified_planning first": (
@@ -314,17 +318,17 @@ def test_the_engines_are_registered_in_either_import_order(order):
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.split("\n")[:2] == [
-        "arrange-up arrange_up.up.engines SOLVED_SATISFICING",
+        "arrange-up arrange_up.up.planner_engine SOLVED_SATISFICING",
         "arrange-up",
     ]
 
 
 def test_the_engine_classes_are_module_level_and_picklable():
     for name, module, class_name in registration.ENGINES:
-        cls = getattr(engines, class_name)
+        cls = getattr(importlib.import_module(module), class_name)
         assert (cls.__module__, cls.__qualname__) == (module, class_name)
         assert get_environment().factory.engines.count(name) == 1
-    assert pickle.loads(pickle.dumps(engines.ArrangeUpPlanner)) is engines.ArrangeUpPlanner
+        assert pickle.loads(pickle.dumps(cls)) is cls
 
 
 def test_the_example_runs(capsys):
