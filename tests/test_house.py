@@ -2,9 +2,9 @@
 
 A room is a sub-package of ``arrange_up`` (or a top-level module such as ``search``); ``LAYERS``
 lists them bottom-up, rooms on one line being peers that must not import each other. Every import
-of the package's own modules counts, at module level or inside a function. The top-level modules
-that keep former import paths working (``FORMER_PATHS``) and the package's ``__init__`` sit above
-every room; the package root itself may be imported anywhere for its ``__version__``.
+of the package's own modules counts, at module level or inside a function. The package's
+``__init__`` and ``__main__`` sit above every room; the package root itself may be imported
+anywhere for its ``__version__``.
 """
 
 from __future__ import annotations
@@ -33,11 +33,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("experiments",),
     ("cli",),
 )
-FORMER_PATHS = (
-    "compile", "domains", "engines", "errors", "evaluate", "loader", "pddl", "planfile",
-    "planner", "problem",
-)  # fmt: skip
-TOP = ("__init__", "__main__", *FORMER_PATHS)
+TOP = ("__init__", "__main__")
 ROOT_METADATA = ("arrange_up", "arrange_up.__version__")
 LEVEL = {room: level for level, rooms in enumerate(LAYERS) for room in rooms}
 

@@ -64,12 +64,6 @@ def test_the_pool_is_the_one_the_particle_semantics_use():
     assert before == ours
 
 
-def test_one_core_counter():
-    from arrange_up.transitions import particles
-
-    assert particles.default_workers is parallel.available_cores
-
-
 def test_errors_in_workers_reach_the_caller():
     with pytest.raises(RuntimeError, match="rollout 5 broke"):
         list(get_runner("local", workers=2).map(_boom, range(10), chunksize=2))

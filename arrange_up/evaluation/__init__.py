@@ -11,7 +11,7 @@ from arrange_up.evaluation.records import *  # noqa: F403
 from arrange_up.evaluation.reliability import *  # noqa: F403
 from arrange_up.evaluation.rollouts import *  # noqa: F403
 
-#: Every public name of the evaluation room, as the former module ``arrange_up.evaluate`` had.
+#: Every public name of the evaluation room's modules.
 __all__ = [
     *outcomes.__all__,
     *reliability.__all__,

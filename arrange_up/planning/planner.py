@@ -40,14 +40,8 @@ from arrange_up.search import SearchResult, SearchStats, SearchStatus, best_firs
 from arrange_up.transitions import simulates_pushes
 
 __all__ = [
-    "CANCELLED",
     "DEFAULT_MAX_NODES",
     "DEFAULT_WEIGHT",
-    "EXHAUSTED",
-    "NODE_LIMIT",
-    "SOLVED",
-    "TIMEOUT",
-    "UNSOLVABLE",
     "VARIETY_SPLIT",
     "PartMiss",
     "PlanResult",
@@ -58,15 +52,6 @@ __all__ = [
     "plan",
     "too_large",
 ]
-
-#: The statuses of a planning run are those of the search (a string enum: ``"solved"``,
-#: ``"node-limit"``, ...); these names are kept for the callers that import them from here.
-SOLVED = SearchStatus.SOLVED
-NODE_LIMIT = SearchStatus.NODE_LIMIT
-TIMEOUT = SearchStatus.TIMEOUT
-EXHAUSTED = SearchStatus.EXHAUSTED
-UNSOLVABLE = SearchStatus.UNSOLVABLE
-CANCELLED = SearchStatus.CANCELLED
 
 
 @dataclass(frozen=True)

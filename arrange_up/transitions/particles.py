@@ -67,7 +67,6 @@ from arrange_up.model.world import (
     nominal_initial_state,
     nominal_noise,
 )
-from arrange_up.parallel import available_cores as default_workers  # noqa: F401  (its former name here)
 from arrange_up.parallel import local_executor
 from arrange_up.physics.simulation import DEFAULT_SETTINGS, StepStatus, simulate
 

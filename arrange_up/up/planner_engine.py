@@ -72,6 +72,7 @@ from unified_planning.plans import Plan
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.planning import planner
 from arrange_up.planning.validation import check_validate
+from arrange_up.search import SearchStatus
 from arrange_up.transitions import available
 from arrange_up.up.engine_base import (
     ArrangeUpEngine,
@@ -239,17 +240,17 @@ class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
                 validation_searches=str(len(outcome.validation.rounds)),
             )
         limit = outcome.stats.get("max_nodes")
-        if outcome.status == planner.SOLVED and outcome.actions is not None:
+        if outcome.status == SearchStatus.SOLVED and outcome.actions is not None:
             plan, logs = answer_plan(problem, arrangement, outcome.actions)
             if outcome.validation is not None:
                 logs = [*logs, LogMessage(LogLevel.INFO, outcome.validation.line())]
             return result(Status.SOLVED_SATISFICING, plan, logs, metrics)
-        if outcome.status == planner.TIMEOUT or (
-            outcome.status == planner.CANCELLED and out_of_time()
+        if outcome.status == SearchStatus.TIMEOUT or (
+            outcome.status == SearchStatus.CANCELLED and out_of_time()
         ):
             message = f"timeout of {timeout} s reached without a plan"
             return result(Status.TIMEOUT, None, [LogMessage(LogLevel.INFO, message)], metrics)
-        if outcome.status == planner.NODE_LIMIT:
+        if outcome.status == SearchStatus.NODE_LIMIT:
             message = (
                 f"node limit of {limit} expanded nodes reached without a plan; the search is "
                 "incomplete, so the problem is not proven unsolvable"
@@ -257,7 +258,7 @@ class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
             return result(
                 Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
             )
-        if outcome.status == planner.EXHAUSTED:
+        if outcome.status == SearchStatus.EXHAUSTED:
             message = (
                 f"{outcome.reason}; the action generators and dominance pruning make the search "
                 "incomplete, so the problem is not proven unsolvable"
@@ -265,7 +266,7 @@ class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
             return result(
                 Status.UNSOLVABLE_INCOMPLETELY, None, [LogMessage(LogLevel.INFO, message)], metrics
             )
-        if outcome.status == planner.UNSOLVABLE:
+        if outcome.status == SearchStatus.UNSOLVABLE:
             message = str(outcome.reason)
             return result(
                 Status.UNSOLVABLE_PROVEN, None, [LogMessage(LogLevel.INFO, message)], metrics

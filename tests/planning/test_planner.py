@@ -15,9 +15,6 @@ from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.world import Place, Push, nominal_initial_state, nominal_noise
 from arrange_up.physics.simulation import simulate
 from arrange_up.planning.planner import (
-    NODE_LIMIT,
-    SOLVED,
-    TIMEOUT,
     PlanStatistics,
     SearchSnapshot,
     plan,
@@ -47,7 +44,7 @@ def _replays_to_goal(problem, actions) -> bool:
 
 def test_deterministic_plan_reaches_goal_in_nominal_physics(blocks2):
     result = plan(blocks2, semantics="deterministic")
-    assert result.status == SOLVED and result.actions
+    assert result.status == SearchStatus.SOLVED and result.actions
     assert _replays_to_goal(blocks2, result.actions)
     assert {type(a) for a in result.actions} == {Place, Push}
     assert result.stats["expanded"] >= 1 and result.stats["transitions_simulated"] >= 1
@@ -58,13 +55,13 @@ def test_dense_parts_still_get_a_nominal_plan():
     # follows the problem's masses (physics.push_force), so nominal pushes move them.
     problem = load("tt-mating-noisy")
     result = plan(problem, semantics="deterministic")
-    assert result.status == SOLVED and result.actions
+    assert result.status == SearchStatus.SOLVED and result.actions
     assert _replays_to_goal(problem, result.actions)
 
 
 def test_particle_plan_final_belief_satisfies_goal_for_every_particle(blocks2):
     result = plan(blocks2, semantics="particles", particles=8, seed=3)
-    assert result.status == SOLVED
+    assert result.status == SearchStatus.SOLVED
     final = result.beliefs[-1]
     assert len(final) == 8
     assert GoalTest(blocks2).satisfied_array(final.poses, final.names())
@@ -91,16 +88,16 @@ def test_worker_processes_do_not_change_the_result(blocks2):
 
 def test_node_limit_and_timeout_are_reported_honestly(blocks2):
     limited = plan(blocks2, semantics="deterministic", max_nodes=1)
-    assert limited.status == NODE_LIMIT and limited.actions is None
+    assert limited.status == SearchStatus.NODE_LIMIT and limited.actions is None
     assert limited.stats["expanded"] == 1
     timed = plan(blocks2, semantics="deterministic", timeout=1e-9)
-    assert timed.status == TIMEOUT and timed.actions is None
+    assert timed.status == SearchStatus.TIMEOUT and timed.actions is None
 
 
 def test_status_and_statistics_are_typed_and_serialise_as_before(blocks2):
     snapshots = []
     result = plan(blocks2, semantics="deterministic", progress=snapshots.append)
-    assert result.status is SearchStatus.SOLVED and result.status == "solved" == SOLVED
+    assert result.status is SearchStatus.SOLVED and result.status == "solved"
     assert json.dumps(result.status) == '"solved"'
     assert isinstance(result.statistics, PlanStatistics)
     assert result.stats == result.statistics.to_json()
@@ -336,7 +333,7 @@ def test_a_solved_run_has_no_reason():
 
 def test_a_node_limit_says_which_parts_the_best_belief_has_not_placed(blocks2):
     result = plan(blocks2, semantics="deterministic", max_nodes=1)
-    assert result.status is NODE_LIMIT
+    assert result.status is SearchStatus.NODE_LIMIT
     assert result.reason.startswith("node-limit after 1 node: ")
     assert result.reason.endswith(
         "the best belief still misses A (not on the table), B (not on the table)"
