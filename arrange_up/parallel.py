@@ -85,6 +85,8 @@ from concurrent.futures import FIRST_COMPLETED, wait
 from itertools import islice
 from typing import Any, Generic, TypeVar
 
+from arrange_up.counts import check_count
+
 __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
@@ -159,8 +161,7 @@ class Runner:
 
 
 def _check_chunksize(chunksize: int) -> int:
-    if not isinstance(chunksize, int) or isinstance(chunksize, bool) or chunksize < 1:
-        raise ValueError(f"chunksize must be a positive integer, got {chunksize!r}")
+    check_count("chunksize", chunksize)
     return chunksize
 
 
@@ -588,10 +589,8 @@ def check_runner_options(
     whether a runner is made or not."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
-    if workers is not None and (
-        not isinstance(workers, int) or isinstance(workers, bool) or workers < 1
-    ):
-        raise ValueError(f"workers must be a positive integer, got {workers!r}")
+    if workers is not None:
+        check_count("workers", workers)
     if scheduler is not None and backend != "dask":
         raise ValueError("a scheduler address needs the dask backend")
 

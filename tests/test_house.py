@@ -17,6 +17,7 @@ import pytest
 PACKAGE_DIR = Path(__file__).resolve().parents[1] / "arrange_up"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
+    ("counts",),
     ("search", "parallel", "model"),
     ("geometry",),
     ("io",),

@@ -28,6 +28,7 @@ from arrange_up.cbst.model import (
     load_model,
     shipped_name,
 )
+from arrange_up.counts import is_number
 from arrange_up.model.problem import ArrangementProblem, Controller, ControllerKind
 from arrange_up.physics.settings import DEFAULT_SETTINGS, push_force
 
@@ -75,7 +76,7 @@ def card_controller(card: Mapping[str, Any], where: str | Path = "the model card
         value = record[f.name]
         if value == "default":
             value = None
-        elif isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+        elif not is_number(value) or value <= 0:
             raise ValueError(
                 f"{where}: controller {f.name} must be a positive number or 'default', "
                 f"got {value!r}"

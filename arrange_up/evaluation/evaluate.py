@@ -34,6 +34,7 @@ from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
 
+from arrange_up.counts import check_count
 from arrange_up.evaluation.outcomes import (
     RolloutRecord,
 )
@@ -124,16 +125,12 @@ def evaluate_plan(
         When the backend is missing.
     """
     started = time.perf_counter()
-    if not isinstance(rollouts, int) or isinstance(rollouts, bool) or rollouts < 1:
-        raise ValueError(f"rollouts must be a positive integer, got {rollouts!r}")
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    check_count("rollouts", rollouts)
+    check_count("seed", seed, minimum=0)
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
-    if chunksize is not None and (
-        not isinstance(chunksize, int) or isinstance(chunksize, bool) or chunksize < 1
-    ):
-        raise ValueError(f"chunksize must be a positive integer, got {chunksize!r}")
+    if chunksize is not None:
+        check_count("chunksize", chunksize)
     check_landing(landing)
     actions = tuple(actions)
     for action in actions:

@@ -12,6 +12,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from arrange_up.counts import is_integer
+
 __all__ = [
     "ACTION_FAILED",
     "FAILURE_KINDS",
@@ -119,7 +121,7 @@ class RolloutRecord:
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> RolloutRecord:
         index, success = data["rollout"], data["success"]
-        if not isinstance(index, int) or isinstance(index, bool) or index < 0:
+        if not is_integer(index) or index < 0:
             raise ValueError(f"rollout: expected a non-negative integer, got {index!r}")
         if not isinstance(success, bool):
             raise ValueError(f"success: expected true or false, got {success!r}")

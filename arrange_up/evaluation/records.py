@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import IO, Any
 
+from arrange_up.counts import is_integer, is_number
 from arrange_up.evaluation.outcomes import FAILURE_KINDS, GOAL_MISSED, RolloutRecord
 from arrange_up.io.files import lock_exclusively, numbered_records, recorded_lines
 from arrange_up.model.problem import ArrangementProblem
@@ -111,7 +112,7 @@ def _record_problem(data: Any, actions: Any) -> str | None:
     if failure["kind"] == GOAL_MISSED:
         if action is not None:
             return f"failure.action: a missed goal names no action, got {action!r}"
-    elif not _is_int(action) or not 0 <= action < (actions if _is_int(actions) else 0):
+    elif not is_integer(action) or not 0 <= action < (actions if is_integer(actions) else 0):
         return (
             f"failure.action: expected the 0-based index of an action of the plan's {actions}, "
             f"got {action!r}"
@@ -136,18 +137,10 @@ def _record_problem(data: Any, actions: Any) -> str | None:
         if (
             not isinstance(excess, list)
             or len(excess) != 3
-            or not all(_is_number(e) and math.isfinite(e) for e in excess)
+            or not all(is_number(e) and math.isfinite(e) for e in excess)
         ):
             return f"{where}.excess: expected three finite numbers, got {excess!r}"
     return None
-
-
-def _is_int(value: Any) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 class RecordFile:

@@ -38,6 +38,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from arrange_up.counts import is_number
 from arrange_up.io.files import undecodable_place
 from arrange_up.io.validation import angle_problem
 from arrange_up.io.yaml_settings import SERVO_KEYS, controller_factors
@@ -413,7 +414,7 @@ def _round(value: float) -> float:
 
 def _is_number(value: Any) -> bool:
     """A finite number that converts to a double (a 400-digit integer does not)."""
-    if not isinstance(value, int | float) or isinstance(value, bool):
+    if not is_number(value):
         return False
     try:
         return math.isfinite(value)

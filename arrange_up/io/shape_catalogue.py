@@ -32,6 +32,7 @@ from ruamel.yaml.error import YAMLError
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
+from arrange_up.counts import is_number
 from arrange_up.geometry import shapes as geometry
 from arrange_up.io.resources import shipped_dir
 from arrange_up.io.shape_forms import box_shape, ccw_polygon, centred_shape, convex_decomposition
@@ -216,11 +217,7 @@ def build_shape(form: str, value: Any, name: str) -> Shape:
 
 
 def _numbers(value: Any, n: int) -> list[float]:
-    if (
-        not isinstance(value, list)
-        or len(value) != n
-        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
-    ):
+    if not isinstance(value, list) or len(value) != n or not all(is_number(v) for v in value):
         raise ValueError(f"expected a list of {n} numbers, got {value!r}")
     return [float(v) for v in value]
 

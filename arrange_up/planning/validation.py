@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from arrange_up.counts import check_count
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.evaluation.rollouts import rollout_start
@@ -103,8 +104,7 @@ def check_validate(validate: Any, start: Any = None) -> None:
     not from a posterior). Every semantics' plan can be checked."""
     if validate is None:
         return
-    if not isinstance(validate, int) or isinstance(validate, bool) or validate < 0:
-        raise ValueError(f"validate must be a non-negative integer, got {validate!r}")
+    check_count("validate", validate, minimum=0)
     if validate and start is not None:
         raise ValueError(
             "validate checks plans from the problem's initial belief; a start belief takes none"

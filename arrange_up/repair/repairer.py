@@ -106,6 +106,7 @@ from typing import Any
 import numpy as np
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval, ParticleBelief
+from arrange_up.counts import check_count
 from arrange_up.geometry import shapes as geometry
 from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import Action, Pick, Place, Push, WorldState
@@ -434,12 +435,9 @@ class Repairer:
     ) -> None:
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
-        if not isinstance(particles, int) or isinstance(particles, bool) or particles < 1:
-            raise ValueError(f"particles must be a positive integer, got {particles!r}")
-        if not isinstance(seed, int) or isinstance(seed, bool):
-            raise ValueError(f"seed must be an integer, got {seed!r}")
-        if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
-            raise ValueError(f"workers must be a positive integer, got {workers!r}")
+        check_count("particles", particles)
+        check_count("seed", seed, minimum=None)
+        check_count("workers", workers)
         self.problem = problem
         self.particles = particles
         self.seed = seed

@@ -48,6 +48,7 @@ from unified_planning.engines.mixins.oneshot_planner import OptimalityGuarantee
 from unified_planning.model import ProblemKind
 from unified_planning.plans import PlanKind
 
+from arrange_up.counts import check_count, is_number
 from arrange_up.parallel import BACKENDS
 from arrange_up.up.compile import TO_UP_KIND
 from arrange_up.up.registration import ENGINE_NAME, REPAIRER_NAME, VALIDATOR_NAME
@@ -146,28 +147,21 @@ class Satisficing:
 def check_seed(engine: str, seed: Any) -> None:
     """The engines' ``seed`` parameter: a non-negative integer (as the command line's
     ``--seed``; numpy's seed sequences refuse negative ones, so the check is made up front)."""
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise ValueError(f"{engine}: seed must be a non-negative integer, got {seed!r}")
+    check_count(f"{engine}: seed", seed, minimum=0)
 
 
 def check_timeout(engine: str, timeout: Any) -> None:
-    if timeout is not None and (
-        isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0
-    ):
+    if timeout is not None and (not is_number(timeout) or not timeout > 0):
         raise ValueError(f"{engine}: timeout must be a positive number of seconds, got {timeout!r}")
 
 
 def check_parallel_params(engine: str, workers: Any, backend: Any, scheduler: Any) -> None:
     """The ``workers`` (None: all cores), ``backend`` and ``scheduler`` parameters of an engine
     that runs simulations on :func:`arrange_up.parallel.get_runner`."""
-    if workers is not None and not is_positive_int(workers):
-        raise ValueError(f"{engine}: workers must be a positive integer, got {workers!r}")
+    if workers is not None:
+        check_count(f"{engine}: workers", workers)
     if backend not in BACKENDS:
         expected = " or ".join(repr(b) for b in BACKENDS)
         raise ValueError(f"{engine}: backend must be {expected}, got {backend!r}")
     if scheduler is not None and (backend != "dask" or not isinstance(scheduler, str)):
         raise ValueError(f"{engine}: a scheduler address needs backend='dask'")
-
-
-def is_positive_int(value: Any) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool) and value >= 1

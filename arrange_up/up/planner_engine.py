@@ -69,6 +69,7 @@ from unified_planning.model import AbstractProblem
 from unified_planning.model.state import State
 from unified_planning.plans import Plan
 
+from arrange_up.counts import check_count
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.planning import planner
 from arrange_up.planning.validation import check_validate
@@ -80,7 +81,6 @@ from arrange_up.up.engine_base import (
     check_parallel_params,
     check_seed,
     check_timeout,
-    is_positive_int,
 )
 from arrange_up.up.engine_io import (
     Refusal,
@@ -282,11 +282,10 @@ def _check_params(
         raise ValueError(
             f"arrange-up: unknown semantics {semantics!r}; expected one of {', '.join(available())}"
         )
-    if not is_positive_int(particles):
-        raise ValueError(f"arrange-up: particles must be a positive integer, got {particles!r}")
+    check_count(f"{ENGINE_NAME}: particles", particles)
     check_seed(ENGINE_NAME, seed)
-    if max_nodes is not None and not is_positive_int(max_nodes):
-        raise ValueError(f"arrange-up: max_nodes must be a positive integer, got {max_nodes!r}")
+    if max_nodes is not None:
+        check_count(f"{ENGINE_NAME}: max_nodes", max_nodes)
     try:
         check_validate(validate)
     except ValueError as error:

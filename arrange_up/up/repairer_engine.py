@@ -21,6 +21,7 @@ from unified_planning.model import AbstractProblem
 from unified_planning.plans import Plan
 
 from arrange_up.belief.goals import GoalTest
+from arrange_up.counts import check_count
 from arrange_up.model.problem import ArrangementProblem, ObjectKind
 from arrange_up.model.world import Action, Place, Push
 from arrange_up.repair import METHODS, TIMEOUT, repair_plan
@@ -31,7 +32,6 @@ from arrange_up.up.engine_base import (
     Satisficing,
     check_seed,
     check_timeout,
-    is_positive_int,
 )
 from arrange_up.up.engine_io import (
     Refusal,
@@ -192,16 +192,12 @@ class ArrangeUpFixtureRepairer(Satisficing, ArrangeUpEngine, PlanRepairerMixin):
 
 
 def _check_repairer_params(particles: Any, seed: Any, method: Any, workers: Any) -> None:
-    if not is_positive_int(particles):
-        raise ValueError(
-            f"{REPAIRER_NAME}: particles must be a positive integer, got {particles!r}"
-        )
+    check_count(f"{REPAIRER_NAME}: particles", particles)
     check_seed(REPAIRER_NAME, seed)
     if method not in METHODS:
         expected = " or ".join(repr(m) for m in METHODS)
         raise ValueError(f"{REPAIRER_NAME}: method must be {expected}, got {method!r}")
-    if not is_positive_int(workers):
-        raise ValueError(f"{REPAIRER_NAME}: workers must be a positive integer, got {workers!r}")
+    check_count(f"{REPAIRER_NAME}: workers", workers)
 
 
 def _nominal_shortfall(

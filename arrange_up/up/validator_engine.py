@@ -40,6 +40,7 @@ from unified_planning.engines.results import FailedValidationReason, ValidationR
 from unified_planning.model import AbstractProblem
 from unified_planning.plans import Plan
 
+from arrange_up.counts import check_count
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.outcomes import GOAL_MISSED
 from arrange_up.evaluation.reliability import EvaluationProgress
@@ -48,7 +49,6 @@ from arrange_up.up.engine_base import (
     check_parallel_params,
     check_seed,
     check_timeout,
-    is_positive_int,
 )
 from arrange_up.up.engine_io import Refusal, read_problem_and_plan
 from arrange_up.up.registration import VALIDATOR_NAME
@@ -203,8 +203,7 @@ class ArrangeUpReliability(ArrangeUpEngine, PlanValidatorMixin):
 def _check_validator_params(
     rollouts: Any, seed: Any, workers: Any, backend: Any, scheduler: Any
 ) -> None:
-    if not is_positive_int(rollouts):
-        raise ValueError(f"{VALIDATOR_NAME}: rollouts must be a positive integer, got {rollouts!r}")
+    check_count(f"{VALIDATOR_NAME}: rollouts", rollouts)
     check_seed(VALIDATOR_NAME, seed)
     check_parallel_params(VALIDATOR_NAME, workers, backend, scheduler)
 
