@@ -229,6 +229,7 @@ __all__ = [
     "StepOutcome",
     "StepStatus",
     "pd_gains",
+    "CompliantGains",
     "compliant_gains",
     "push_force",
     "simulate",
@@ -731,7 +732,9 @@ class _Tracking:
         gains = compliant_gains(
             controller, settings, paddle.mass, paddle.moment, paddle.radius, default_force
         )
-        self.kp, self.kd, self.kp_a, self.kd_a, self.force, self.torque, self.speed = gains
+        self.kp, self.kd = gains.kp, gains.kd
+        self.kp_a, self.kd_a = gains.kp_angle, gains.kd_angle
+        self.force, self.torque, self.speed = gains.force, gains.torque, gains.speed
         self.space_dt = settings.dt
         self.paddle = paddle.body
         self.start = paddle.pose
@@ -955,6 +958,27 @@ class _RestCount:
         self.last = now
 
 
+@dataclass(frozen=True)
+class CompliantGains:
+    """The compliant controller's gains and clips for one paddle, resolved
+    (:func:`compliant_gains`)."""
+
+    kp: float
+    """Proportional gain per axis (force per inch of tracking error)."""
+    kd: float
+    """Derivative gain per axis: ``damping_ratio * sqrt(4 m Kp)``."""
+    kp_angle: float
+    """Proportional gain on the angle (torque per radian)."""
+    kd_angle: float
+    """Derivative gain on the angle: ``damping_ratio * sqrt(4 I Kp_angle)``."""
+    force: float
+    """Clip of the force on each axis."""
+    torque: float
+    """Clip of the torque."""
+    speed: float
+    """Speed of the set point along the push line (in/s)."""
+
+
 def compliant_gains(
     controller: Controller,
     settings: PhysicsSettings,
@@ -962,14 +986,14 @@ def compliant_gains(
     moment: float,
     radius: float,
     default_force: float,
-) -> tuple[float, float, float, float, float, float, float]:
-    """``(Kp, Kd, Kp_angle, Kd_angle, force clip, torque clip, speed)`` of the compliant
-    controller for a paddle of ``mass``, ``moment`` and ``radius`` (the largest distance of
-    its outline from its centroid), the ``None`` fields of ``controller`` at their defaults
-    (:class:`~arrange_up.model.problem.Controller`): ``Kp_angle = Kp radius^2``, so that a
-    force at the paddle's end moves that end about as far by turning it as a force at its
-    centre moves the centre (a wrist as stiff as the arm), and ``torque = force * radius``;
-    ``Kd = damping_ratio * sqrt(4 m Kp)`` and likewise on the angle."""
+) -> CompliantGains:
+    """The gains and clips of the compliant controller for a paddle of ``mass``, ``moment`` and
+    ``radius`` (the largest distance of its outline from its centroid), the ``None`` fields of
+    ``controller`` at their defaults (:class:`~arrange_up.model.problem.Controller`), the force
+    clip at ``default_force``: ``Kp_angle = Kp radius^2``, so that a force at the paddle's end
+    moves that end about as far by turning it as a force at its centre moves the centre (a
+    wrist as stiff as the arm), and ``torque = force * radius``; ``Kd = damping_ratio *
+    sqrt(4 m Kp)`` and likewise on the angle."""
     kp = controller.kp
     kp_a = kp * radius * radius if controller.kp_angle is None else controller.kp_angle
     force = default_force if controller.force is None else controller.force
@@ -978,7 +1002,7 @@ def compliant_gains(
     zeta = settings.damping_ratio
     kd = zeta * math.sqrt(4.0 * mass * kp)
     kd_a = zeta * math.sqrt(4.0 * moment * kp_a)
-    return kp, kd, kp_a, kd_a, force, torque, speed
+    return CompliantGains(kp, kd, kp_a, kd_a, force, torque, speed)
 
 
 #: The largest ``sqrt(K / m) * dt`` (and ``sqrt(K_angle / I) * dt``) at which the compliant
@@ -1007,9 +1031,8 @@ def stiff_manipulators(
         body = compiled.bodies[spec.name]
         mass = rho * body.area
         moment = sum(rho * area * unit for area, unit in body.part_moments)
-        kp, _, kp_a, _, _, _, _ = compliant_gains(
-            controller, settings, mass, moment, body.radius, force
-        )
+        gains = compliant_gains(controller, settings, mass, moment, body.radius, force)
+        kp, kp_a = gains.kp, gains.kp_angle
         dt = settings.dt
         rate = max(math.sqrt(kp / mass) * dt, math.sqrt(kp_a / moment) * dt)
         if rate > STABLE_RATE:
