@@ -227,7 +227,7 @@ __all__ = [
     "DEFAULT_SETTINGS",
     "PhysicsSettings",
     "StepOutcome",
-    "StepStatus",
+    "SimulationStatus",
     "pd_gains",
     "CompliantGains",
     "compliant_gains",
@@ -244,7 +244,7 @@ __all__ = [
 # ----------------------------------------------------------------------------------------------
 
 
-class StepStatus(enum.StrEnum):
+class SimulationStatus(enum.StrEnum):
     """How an action's simulation ended. Anything but ``OK`` makes the outcome unreliable."""
 
     OK = "ok"
@@ -277,7 +277,7 @@ class StepOutcome:
     """
 
     state: WorldState
-    status: StepStatus = StepStatus.OK
+    status: SimulationStatus = SimulationStatus.OK
     off_table: tuple[str, ...] = ()
     sim_time: float = 0.0
     steps: int = 0
@@ -287,7 +287,7 @@ class StepOutcome:
 
     @property
     def ok(self) -> bool:
-        return self.status is StepStatus.OK
+        return self.status is SimulationStatus.OK
 
 
 # ----------------------------------------------------------------------------------------------
@@ -350,11 +350,11 @@ def _off_table(table: Table, poses: Sequence[tuple[str, Pose]]) -> tuple[str, ..
 
 
 def _finish(
-    compiled: _Compiled, poses: tuple[tuple[str, Pose], ...], status: StepStatus, **kw
+    compiled: _Compiled, poses: tuple[tuple[str, Pose], ...], status: SimulationStatus, **kw
 ) -> StepOutcome:
     off = _off_table(compiled.table, poses)
-    if status is StepStatus.OK and off:
-        status = StepStatus.OFF_TABLE
+    if status is SimulationStatus.OK and off:
+        status = SimulationStatus.OFF_TABLE
     return StepOutcome(WorldState(poses), status, off, **kw)
 
 
@@ -376,7 +376,7 @@ def _place(
     mapping[action.obj] = placed
     order = [spec.name for spec in compiled.problem.objects if spec.name in mapping]
     poses = tuple((name, mapping[name]) for name in order)
-    return _finish(compiled, poses, StepStatus.OK)
+    return _finish(compiled, poses, SimulationStatus.OK)
 
 
 def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
@@ -385,7 +385,7 @@ def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
     if action.obj not in state:
         raise ValueError(f"pick: {action.obj!r} is not on the table")
     poses = tuple((name, pose) for name, pose in state.poses if name != action.obj)
-    return _finish(compiled, poses, StepStatus.OK)
+    return _finish(compiled, poses, SimulationStatus.OK)
 
 
 def _add_drive(
@@ -454,11 +454,11 @@ def _push(
         scene.free()
 
     if overlap > s.overlap_tolerance:
-        status = StepStatus.OVERLAP
+        status = SimulationStatus.OVERLAP
     elif run.capped:
-        status = StepStatus.NOT_AT_REST
+        status = SimulationStatus.NOT_AT_REST
     else:
-        status = StepStatus.OK
+        status = SimulationStatus.OK
     return _finish(
         compiled,
         tuple(poses),

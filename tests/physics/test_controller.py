@@ -23,7 +23,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.physics.bench import scene
 from arrange_up.physics.settings import DEFAULT_SETTINGS
-from arrange_up.physics.simulation import StepStatus, simulate, simulate_watched
+from arrange_up.physics.simulation import SimulationStatus, simulate, simulate_watched
 
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
 FRESH = Path(__file__).resolve().parents[1] / "problems" / "fresh"
@@ -172,9 +172,9 @@ def test_a_wedged_compliant_push_comes_to_rest_with_more_solver_iterations():
         manipulator_density=0.4,
     )
     settled = simulate(problem, state, push, noise)
-    assert settled.status is StepStatus.OK
+    assert settled.status is SimulationStatus.OK
     assert settled.sim_time < 2.5
     x, y, _ = settled.state.as_dict()["A"]
     assert abs(x - 5.41) < 0.02 and abs(y - 0.59) < 0.02
     chattering = simulate(problem, state, push, noise, replace(DEFAULT_SETTINGS, stuck_time=0.0))
-    assert chattering.status is StepStatus.NOT_AT_REST
+    assert chattering.status is SimulationStatus.NOT_AT_REST
