@@ -191,6 +191,7 @@ import math
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 # pymunk's cffi binding: the Chipmunk2D C API that pymunk's classes wrap (pymunk ~= 7.3).
 from pymunk._chipmunk_cffi import ffi, lib
@@ -234,6 +235,7 @@ __all__ = [
     "push_force",
     "simulate",
     "simulate_watched",
+    "StiffManipulator",
     "stiff_manipulators",
     "STABLE_RATE",
 ]
@@ -1011,15 +1013,25 @@ def compliant_gains(
 STABLE_RATE = 0.5
 
 
+class StiffManipulator(NamedTuple):
+    """A manipulator the compliant controller is too stiff for (:func:`stiff_manipulators`)."""
+
+    name: str
+    rate: float
+    """The larger of ``sqrt(Kp / m) dt`` and ``sqrt(Kp_angle / I) dt``."""
+    kp_max: float
+    """The largest ``kp`` that keeps the rate at :data:`STABLE_RATE`."""
+
+
 def stiff_manipulators(
     problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS
-) -> list[tuple[str, float, float]]:
-    """The manipulators the problem's compliant controller is too stiff for at the time step:
-    ``(name, rate, kp_max)``, ``rate`` the larger of ``sqrt(Kp / m) dt`` and
-    ``sqrt(Kp_angle / I) dt`` at the lightest manipulator density, above :data:`STABLE_RATE`,
-    and ``kp_max`` the largest ``kp`` (internal units) that keeps both at it when the angle
-    gain is its default ``kp r^2`` (with an explicit ``kp_angle``, the linear bound alone).
-    Empty under the servo."""
+) -> list[StiffManipulator]:
+    """The manipulators the problem's compliant controller is too stiff for at the time step,
+    as :class:`StiffManipulator` ``(name, rate, kp_max)``: ``rate`` the larger of
+    ``sqrt(Kp / m) dt`` and ``sqrt(Kp_angle / I) dt`` at the lightest manipulator density,
+    above :data:`STABLE_RATE`, and ``kp_max`` the largest ``kp`` (internal units) that keeps
+    both at it when the angle gain is its default ``kp r^2`` (with an explicit ``kp_angle``,
+    the linear bound alone). Empty under the servo."""
     controller = problem.controller
     if controller.kind is not ControllerKind.COMPLIANT:
         return []
@@ -1039,7 +1051,7 @@ def stiff_manipulators(
             limit = mass * (STABLE_RATE / dt) ** 2
             if controller.kp_angle is None:
                 limit = min(limit, moment / body.radius**2 * (STABLE_RATE / dt) ** 2)
-            found.append((spec.name, rate, limit))
+            found.append(StiffManipulator(spec.name, rate, limit))
     return found
 
 

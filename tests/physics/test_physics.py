@@ -473,9 +473,10 @@ def test_a_controller_too_stiff_for_a_light_paddle_is_named_with_the_gain_that_i
     from arrange_up.physics.simulation import STABLE_RATE, stiff_manipulators
 
     tiny = catalogue.tiny("millimetre-paddle")
-    [(name, rate, kp_max)] = stiff_manipulators(tiny)
-    assert name == "tip" and rate > 2 * STABLE_RATE and 1.0 < kp_max < 300.0
-    at_limit = dataclasses.replace(tiny, controller=dataclasses.replace(tiny.controller, kp=kp_max))
+    [stiff] = stiff_manipulators(tiny)
+    assert stiff.name == "tip" and stiff.rate > 2 * STABLE_RATE and 1.0 < stiff.kp_max < 300.0
+    controller = dataclasses.replace(tiny.controller, kp=stiff.kp_max)
+    at_limit = dataclasses.replace(tiny, controller=controller)
     assert stiff_manipulators(at_limit) == []
     servo = dataclasses.replace(tiny, controller=SERVO_CONTROLLER)
     assert stiff_manipulators(servo) == []
