@@ -106,10 +106,8 @@ def stiff_wrist(scale: float) -> Controller:
     radius = problem.object("paddle").shape.radius
     # the physics' own defaults; the angle gain and torque clip do not depend on the paddle's
     # mass and moment (they set only the damping, not read here)
-    _, _, kp_angle, _, _, torque, _ = compliant_gains(
-        COMPLIANT, DEFAULT_SETTINGS, 1.0, 1.0, radius, push_force(problem)
-    )
-    return replace(COMPLIANT, kp_angle=scale * kp_angle, torque=scale * torque)
+    gains = compliant_gains(COMPLIANT, DEFAULT_SETTINGS, 1.0, 1.0, radius, push_force(problem))
+    return replace(COMPLIANT, kp_angle=scale * gains.kp_angle, torque=scale * gains.torque)
 
 
 def tilt(wrists: tuple[float, ...] = ()) -> None:

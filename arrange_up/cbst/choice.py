@@ -21,13 +21,8 @@ from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
-from arrange_up.cbst.model import (
-    DEFAULT_MODEL,
-    SHIPPED_MODELS,
-    TrainedModel,
-    load_model,
-    shipped_name,
-)
+from arrange_up.cbst.store import DEFAULT_MODEL, SHIPPED_MODELS, load_model, shipped_name
+from arrange_up.cbst.trained import TrainedModel
 from arrange_up.counts import is_number
 from arrange_up.model.problem import ArrangementProblem, Controller, ControllerKind
 from arrange_up.physics.settings import DEFAULT_SETTINGS, push_force
@@ -127,7 +122,7 @@ def model_for(
     controller.
 
     Raises ``LookupError`` for an unknown name, and ``ValueError`` for a model that does not
-    load (:func:`~arrange_up.cbst.model.load_model`) or was trained under another controller:
+    load (:func:`~arrange_up.cbst.store.load_model`) or was trained under another controller:
     the message names the model, both controllers and what to use instead."""
     wanted = problem.controller
     resolved = shipped_name(name_or_path, wanted)

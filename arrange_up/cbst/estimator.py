@@ -1,6 +1,6 @@
 """The learned PREDICT of CBST as a scikit-learn estimator: :class:`CBSTRegressor`, which
 training and tuning (:mod:`arrange_up.cbst.model`) fit. A stored model is read back without
-scikit-learn, as a :class:`~arrange_up.cbst.model.TrainedModel`.
+scikit-learn, as a :class:`~arrange_up.cbst.trained.TrainedModel`.
 
 * :class:`CBSTRegressor` is a scikit-learn estimator (hyperparameters only in ``__init__``,
   ``fit`` validates and returns ``self``, learned state ends in ``_``) wrapping a
@@ -15,7 +15,7 @@ from sklearn.base import BaseEstimator, MultiOutputMixin, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from arrange_up.cbst.fast_forest import FastForest
-from arrange_up.cbst.model import check_residual, predict_rows
+from arrange_up.cbst.trained import check_residual, predict_rows
 
 __all__ = ["CBSTRegressor"]
 

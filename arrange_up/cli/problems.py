@@ -118,13 +118,13 @@ def _warn_stiff(shown: str, problem: ArrangementProblem) -> None:
     default ``kp``)."""
     from arrange_up.physics.simulation import STABLE_RATE, stiff_manipulators
 
-    for name, rate, kp_max in stiff_manipulators(problem):
+    for stiff in stiff_manipulators(problem):
         click.echo(
             f"{shown}: warning: controller: the compliant controller (kp "
-            f"{problem.controller.kp:g}) is too stiff for manipulator {name!r} at the "
-            f"physics' time step (sqrt(kp / m) x dt up to {rate:.2f}, stable below "
+            f"{problem.controller.kp:g}) is too stiff for manipulator {stiff.name!r} at the "
+            f"physics' time step (sqrt(kp / m) x dt up to {stiff.rate:.2f}, stable below "
             f"{STABLE_RATE:g}): its pushes oscillate and throw parts; give controller.kp at "
-            f"most {kp_max:.3g}, or kind: servo",
+            f"most {stiff.kp_max:.3g}, or kind: servo",
             err=True,
         )
 

@@ -58,8 +58,8 @@ from arrange_up.physics import simulation  # simulate looked up per call: tests 
 from arrange_up.physics.simulation import (
     DEFAULT_SETTINGS,
     PhysicsSettings,
+    SimulationStatus,
     StepOutcome,
-    StepStatus,
 )
 
 __all__ = [
@@ -202,7 +202,7 @@ class Rollouts:
             outcome = simulation.simulate(problem, state, action, noise, self.push_settings)
         except ValueError as error:
             return Step(state, None, Failure(ACTION_FAILED, k, str(error)))
-        if outcome.status is StepStatus.OVERLAP:
+        if outcome.status is SimulationStatus.OVERLAP:
             return Step(
                 state,
                 outcome,
@@ -213,9 +213,9 @@ class Rollouts:
                     f"deepest overlap {length(outcome.overlap, '.4f')}",
                 ),
             )
-        if outcome.status is StepStatus.NOT_AT_REST:
+        if outcome.status is SimulationStatus.NOT_AT_REST:
             return Step(state, outcome, Failure(NOT_AT_REST, k))
-        if outcome.status is StepStatus.OFF_TABLE:
+        if outcome.status is SimulationStatus.OFF_TABLE:
             return Step(state, outcome, Failure(OFF_TABLE, k, objects=tuple(outcome.off_table)))
         state = outcome.state
         if isinstance(action, Place):

@@ -46,7 +46,12 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import ActionNoise, Push, WorldState, draw_noise
 from arrange_up.parallel import local_executor
 from arrange_up.physics.settings import SERVO_VALUES
-from arrange_up.physics.simulation import DEFAULT_SETTINGS, PhysicsSettings, StepStatus, simulate
+from arrange_up.physics.simulation import (
+    DEFAULT_SETTINGS,
+    PhysicsSettings,
+    SimulationStatus,
+    simulate,
+)
 
 SCENES: tuple[str, ...] = ("1 block", "3-block chain", "7-block chain")
 
@@ -122,7 +127,7 @@ def _run_chunk(
     for state, noise in tasks:
         outcome = simulate(problem, state, push, noise)
         sim_time += outcome.sim_time
-        if outcome.status is StepStatus.NOT_AT_REST:
+        if outcome.status is SimulationStatus.NOT_AT_REST:
             not_at_rest += 1
         elif not outcome.ok:
             other += 1

@@ -191,6 +191,7 @@ import math
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 # pymunk's cffi binding: the Chipmunk2D C API that pymunk's classes wrap (pymunk ~= 7.3).
 from pymunk._chipmunk_cffi import ffi, lib
@@ -227,12 +228,14 @@ __all__ = [
     "DEFAULT_SETTINGS",
     "PhysicsSettings",
     "StepOutcome",
-    "StepStatus",
+    "SimulationStatus",
     "pd_gains",
+    "CompliantGains",
     "compliant_gains",
     "push_force",
     "simulate",
     "simulate_watched",
+    "StiffManipulator",
     "stiff_manipulators",
     "STABLE_RATE",
 ]
@@ -243,7 +246,7 @@ __all__ = [
 # ----------------------------------------------------------------------------------------------
 
 
-class StepStatus(enum.StrEnum):
+class SimulationStatus(enum.StrEnum):
     """How an action's simulation ended. Anything but ``OK`` makes the outcome unreliable."""
 
     OK = "ok"
@@ -276,7 +279,7 @@ class StepOutcome:
     """
 
     state: WorldState
-    status: StepStatus = StepStatus.OK
+    status: SimulationStatus = SimulationStatus.OK
     off_table: tuple[str, ...] = ()
     sim_time: float = 0.0
     steps: int = 0
@@ -286,7 +289,7 @@ class StepOutcome:
 
     @property
     def ok(self) -> bool:
-        return self.status is StepStatus.OK
+        return self.status is SimulationStatus.OK
 
 
 # ----------------------------------------------------------------------------------------------
@@ -349,11 +352,11 @@ def _off_table(table: Table, poses: Sequence[tuple[str, Pose]]) -> tuple[str, ..
 
 
 def _finish(
-    compiled: _Compiled, poses: tuple[tuple[str, Pose], ...], status: StepStatus, **kw
+    compiled: _Compiled, poses: tuple[tuple[str, Pose], ...], status: SimulationStatus, **kw
 ) -> StepOutcome:
     off = _off_table(compiled.table, poses)
-    if status is StepStatus.OK and off:
-        status = StepStatus.OFF_TABLE
+    if status is SimulationStatus.OK and off:
+        status = SimulationStatus.OFF_TABLE
     return StepOutcome(WorldState(poses), status, off, **kw)
 
 
@@ -375,7 +378,7 @@ def _place(
     mapping[action.obj] = placed
     order = [spec.name for spec in compiled.problem.objects if spec.name in mapping]
     poses = tuple((name, mapping[name]) for name in order)
-    return _finish(compiled, poses, StepStatus.OK)
+    return _finish(compiled, poses, SimulationStatus.OK)
 
 
 def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
@@ -384,7 +387,7 @@ def _pick(compiled: _Compiled, state: WorldState, action: Pick) -> StepOutcome:
     if action.obj not in state:
         raise ValueError(f"pick: {action.obj!r} is not on the table")
     poses = tuple((name, pose) for name, pose in state.poses if name != action.obj)
-    return _finish(compiled, poses, StepStatus.OK)
+    return _finish(compiled, poses, SimulationStatus.OK)
 
 
 def _add_drive(
@@ -416,6 +419,64 @@ def _push(
     s: PhysicsSettings,
     watch: Callable[[list], None] | None = None,
 ) -> StepOutcome:
+    """Simulate the push ``action`` from ``state`` under ``noise`` (module docstring): build a
+    fresh space, put the paddle down and settle, drive it until it is still, hold it until
+    every other body is at rest (or the cap), and read the poses; everything built is freed.
+
+    The phases are :func:`_check_push`, :class:`_Scene` with :func:`_add_movable_bodies` and
+    :func:`_put_down_paddle`, :func:`_settle`, :func:`_start_drive` and :class:`_PushRun`
+    (:meth:`~_PushRun.drive_until_still`, then :meth:`~_PushRun.hold_until_rest`). ``watch``,
+    when given, is called after every step (:func:`simulate_watched`).
+    """
+    distance = _check_push(compiled, state, action, noise)
+    controller = compiled.problem.controller
+    s = s.for_controller(controller.kind)
+    compliant = controller.kind is ControllerKind.COMPLIANT
+    scene = _Scene(math.sqrt(float(noise.friction)))
+    try:
+        scene.configure(s)
+        scene.add_statics(compiled.statics)
+        movable = _add_movable_bodies(scene, compiled, state, noise, s)
+        paddle = _put_down_paddle(
+            scene, compiled.bodies[action.manipulator], action, noise, compliant
+        )
+        step = lib.cpSpaceStep if watch is None else _watched_step(watch, scene.bodies)
+        overlap = _settle(scene, compiled, state, action.manipulator, paddle.pose, s, step)
+        drive = _start_drive(scene, compiled, controller, paddle, distance, s, step)
+        run = _PushRun(scene, compiled, paddle, drive, movable, distance, s, step, watch)
+        if run.drive_until_still():
+            run.hold_until_rest()
+        poses = []
+        for (obj, _), b in zip(state.poses, movable, strict=True):
+            pos = lib.cpBodyGetPosition(b)
+            poses.append((obj, (pos.x, pos.y, lib.cpBodyGetAngle(b))))
+        pos = lib.cpBodyGetPosition(paddle.body)
+        paddle_pose = (pos.x, pos.y, lib.cpBodyGetAngle(paddle.body))
+    finally:
+        scene.free()
+
+    if overlap > s.overlap_tolerance:
+        status = SimulationStatus.OVERLAP
+    elif run.capped:
+        status = SimulationStatus.NOT_AT_REST
+    else:
+        status = SimulationStatus.OK
+    return _finish(
+        compiled,
+        tuple(poses),
+        status,
+        sim_time=run.steps * s.dt,
+        steps=run.steps,
+        manipulator_travel=run.travel,
+        overlap=overlap,
+        manipulator_pose=paddle_pose,
+    )
+
+
+def _check_push(compiled: _Compiled, state: WorldState, action: Push, noise: ActionNoise) -> float:
+    """The push's distance, after refusing an invalid push with :class:`ValueError`: a pusher
+    that is not a manipulator or is on the table, a negative or non-finite distance, a
+    non-finite approach pose, an invalid noise draw."""
     name = action.manipulator
     kind = _spec_kind(compiled, name, "push")
     if kind is not ObjectKind.MANIPULATOR:
@@ -425,292 +486,231 @@ def _push(
     distance = float(action.distance)
     if not (math.isfinite(distance) and distance >= 0.0):
         raise ValueError(f"push: distance must be finite and non-negative, got {distance!r}")
-
     if not all(math.isfinite(v) for v in action.pose):
         raise ValueError(f"push: approach pose must be finite, got {action.pose!r}")
     _check_noise(noise)
-    controller = compiled.problem.controller
-    s = s.for_controller(controller.kind)
-    mu = float(noise.friction)
-    g = s.gravity
-    shape_mu = math.sqrt(mu)
-    dt = s.dt
-    step = lib.cpSpaceStep
-    get_pos = lib.cpBodyGetPosition
-    get_angle = lib.cpBodyGetAngle
-    add_shape = lib.cpSpaceAddShape
-    add_constraint = lib.cpSpaceAddConstraint
-    set_friction = lib.cpShapeSetFriction
-    set_max_force = lib.cpConstraintSetMaxForce
-    set_max_bias = lib.cpConstraintSetMaxBias
-    new_poly = lib.cpPolyShapeNew
-    identity = _IDENTITY
+    return distance
 
-    space = lib.cpSpaceNew()
-    shapes: list = []
-    constraints: list = []
-    bodies: list = []
-    try:
+
+class _Scene:
+    """The pymunk space of one push and every C object added to it, which :meth:`free` frees
+    (the space does not own its bodies, shapes and constraints). Every shape gets the friction
+    ``shape_mu`` (the square root of the draw's coefficient: pymunk multiplies the two)."""
+
+    def __init__(self, shape_mu: float) -> None:
+        self.space = lib.cpSpaceNew()
+        self.shape_mu = shape_mu
+        self.shapes: list = []
+        self.constraints: list = []
+        self.bodies: list = []
+        self.static = None
+
+    def configure(self, s: PhysicsSettings) -> None:
+        """Set the solver (iterations, slop, bias) and sleeping of ``s``; fetch the static
+        body."""
+        space = self.space
         lib.cpSpaceSetIterations(space, s.iterations)
         lib.cpSpaceSetCollisionSlop(space, s.collision_slop)
         lib.cpSpaceSetCollisionBias(space, s.collision_bias)
         if s.sleep_time > 0.0:
             lib.cpSpaceSetSleepTimeThreshold(space, s.sleep_time)
             lib.cpSpaceSetIdleSpeedThreshold(space, s.rest_linear_tol / s.rest_interval)
-        static = lib.cpSpaceGetStaticBody(space)
+        self.static = lib.cpSpaceGetStaticBody(space)
 
-        def add_body(body, body_def, x: float, y: float, th: float) -> None:
-            """Put ``body`` at its pose in the space with its convex shapes (kept alive)."""
-            bodies.append(body)
-            lib.cpBodySetPosition(body, (x, y))
-            lib.cpBodySetAngle(body, th)
-            lib.cpSpaceAddBody(space, body)
-            for count, verts in body_def.parts:
-                shape = new_poly(body, count, verts, identity, 0.0)
-                shapes.append(shape)
-                set_friction(shape, shape_mu)
-                add_shape(space, shape)
+    def add_statics(self, statics) -> None:
+        """Add the walls and obstacles (``(count, vertices)`` polygons) to the static body."""
+        for count, verts in statics:
+            self._add_shape(self.static, count, verts)
 
-        # 1. walls and obstacles
-        for count, verts in compiled.statics:
-            shape = new_poly(static, count, verts, identity, 0.0)
-            shapes.append(shape)
-            set_friction(shape, shape_mu)
-            add_shape(space, shape)
+    def add_body(self, body, body_def, x: float, y: float, th: float) -> None:
+        """Put ``body`` at its pose in the space with its convex shapes."""
+        self.bodies.append(body)
+        lib.cpBodySetPosition(body, (x, y))
+        lib.cpBodySetAngle(body, th)
+        lib.cpSpaceAddBody(self.space, body)
+        for count, verts in body_def.parts:
+            self._add_shape(body, count, verts)
 
-        # 2. movable bodies, in state order, with table friction
-        for obj, (x, y, th) in state.poses:
-            body_def = compiled.bodies[obj]
-            clamped = body_def.kind is ObjectKind.FIXTURE
-            rho = (
-                noise.manipulator_density
-                if body_def.kind is ObjectKind.MANIPULATOR
-                else noise.part_density
-            )
-            mass = rho * body_def.area
-            if clamped:
-                # Clamped to the table (see the module docstring): a kinematic body that
-                # never moves, with no table friction to model.
-                body = lib.cpBodyNewKinematic()
-            else:
-                moment = 0.0
-                for area_i, unit_moment in body_def.part_moments:
-                    moment += rho * area_i * unit_moment
-                body = lib.cpBodyNew(mass, moment)
-            add_body(body, body_def, x, y, th)
-            if clamped:
-                continue
-            pivot = lib.cpPivotJointNew2(static, body, (0.0, 0.0), (0.0, 0.0))
-            constraints.append(pivot)
-            set_max_bias(pivot, 0.0)
-            set_max_force(pivot, mu * mass * g)
-            add_constraint(space, pivot)
-            gear = lib.cpGearJointNew(static, body, 0.0, 1.0)
-            constraints.append(gear)
-            set_max_bias(gear, 0.0)
-            set_max_force(gear, mu * g * rho * body_def.abs_r)
-            add_constraint(space, gear)
-        n_movable = len(bodies)
+    def _add_shape(self, body, count: int, verts) -> None:
+        shape = lib.cpPolyShapeNew(body, count, verts, _IDENTITY, 0.0)
+        self.shapes.append(shape)
+        lib.cpShapeSetFriction(shape, self.shape_mu)
+        lib.cpSpaceAddShape(self.space, shape)
 
-        # 3. the manipulator at the (noisy) approach pose: infinite moment, no table friction
-        paddle_def = compiled.bodies[name]
-        ox, oy, oth = noise.pose_offset
-        px, py, pth = action.pose
-        px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
-        compliant = controller.kind is ControllerKind.COMPLIANT
-        rho_m = noise.manipulator_density
-        paddle_mass = rho_m * paddle_def.area
-        paddle_moment = math.inf
-        if compliant:
-            # The compliant wrist can turn: the paddle's own moment (same sum as the parts').
-            paddle_moment = 0.0
-            for area_i, unit_moment in paddle_def.part_moments:
-                paddle_moment += rho_m * area_i * unit_moment
-        paddle = lib.cpBodyNew(paddle_mass, paddle_moment)
-        add_body(paddle, paddle_def, px, py, pth)
-        dx, dy = rotate(paddle_def.push_direction, pth)
+    def add_constraint(self, constraint) -> None:
+        """Add ``constraint`` (its limits already set) to the space."""
+        self.constraints.append(constraint)
+        lib.cpSpaceAddConstraint(self.space, constraint)
 
-        if watch is not None:
-            step = _watched_step(watch, bodies)
-        # 4. settle, then look for overlaps in the contacts the engine built, and for the
-        # paddle's own landing in the geometry (the contacts miss a concentric landing)
-        for _ in range(s.settle_steps):
-            step(space, dt)
-        steps = s.settle_steps
-        overlap = 0.0
-        if s.settle_steps:
-            _, landing = compiled.depths.deepest_at(state, name, (px, py, pth))
-            overlap = max(_deepest_overlap(space), landing)
-
-        # 5. drive until the paddle is still, then stop driving and wait until every other
-        # body is at rest. Stopping turns the drive into a brake (no bias: no force toward the
-        # reference, it only holds the paddle where it is). Rest checks every `interval`
-        # steps; the other bodies are watched from the first check the paddle is still, so
-        # their rest can count the check at which the drive stops (always followed by at
-        # least one check with the brake on).
-        force = _force_clip(compiled.problem, compiled.parts_area, s)
-        if compliant:
-            track = _Tracking(
-                controller,
-                s,
-                paddle,
-                paddle_mass,
-                paddle_moment,
-                paddle_def.radius,
-                force,
-                (px, py, pth),
-                (dx, dy),
-                step,
-            )
-            track.distance = distance
-            advance = track.advance
-            drive = None
-        else:
-            if controller.force is not None:
-                force = controller.force
-            drive = _add_drive(
-                space,
-                static,
-                paddle,
-                (px + distance * dx, py + distance * dy),
-                s,
-                force,
-                controller.speed,
-            )
-            constraints.append(drive)
-
-            def advance(n: int) -> None:
-                for _ in range(n):
-                    step(space, dt)
-
-        interval = s.interval_steps
-        speed = s.push_speed if controller.speed is None else controller.speed
-        speed = track.speed if compliant else speed
-        setpoint_end = distance / speed
-        # The cap makes room for the travel across the table at most: a push commanded further
-        # (a plan file may say 1e300 in) ends against a wall or off the table by then.
-        crossing = push_crossing(compiled.table.size, paddle_def.radius)
-        max_steps = s.cap_steps(min(distance, crossing) / speed)
-        lin2 = s.rest_linear_tol * s.rest_linear_tol
-        ang_tol = s.rest_angular_tol
-        need = s.rest_checks
-        movable = bodies[:n_movable]
-        capped = False
-        driving = True
-        paddle_still = 0
-        others_still = 0
-        last = None
-        last_x, last_y = px, py
-        travel = 0.0
-        # A push still not at rest `stuck_time` after its set point's end gets more solver
-        # iterations: chatter of a wedged contact, which more iterations settle (settings).
-        if s.stuck_time > 0.0:
-            stuck_at = math.ceil((setpoint_end + s.stuck_time) / dt)
-        else:
-            stuck_at = max_steps + 1
-        # ...and, once stuck, its drive ends when the paddle's progress along the push over the
-        # last `stall_window` is below the rest speed: chatter is not motion (settings).
-        window = round(s.stall_window / (interval * dt)) if s.stall_window > 0.0 else 0
-        window_progress = s.rest_linear_tol * window
-        progress: deque[float] = deque(maxlen=window + 1)
-        stuck = False
-        while True:
-            if steps >= stuck_at:
-                lib.cpSpaceSetIterations(space, s.stuck_iterations)
-                stuck_at = max_steps + 1
-                stuck = True
-            if steps + interval > max_steps:
-                if driving:
-                    advance(max_steps - steps)
-                else:
-                    for _ in range(max_steps - steps):
-                        step(space, dt)
-                steps = max(steps, max_steps)
-                capped = True
-                if driving:
-                    pos = get_pos(paddle)
-                    last_x, last_y = pos.x, pos.y
-                break
-            if driving:
-                advance(interval)
-            else:
-                for _ in range(interval):
-                    step(space, dt)
-            steps += interval
-            if driving:
-                pos = get_pos(paddle)
-                ex, ey = pos.x - last_x, pos.y - last_y
-                last_x, last_y = pos.x, pos.y
-                # The compliant paddle must also have stopped turning, its set point at its end.
-                done = drive is not None or track.still(ang_tol)
-                if stuck and window:
-                    progress.append(pos.x * dx + pos.y * dy)
-                if len(progress) > window and abs(progress[-1] - progress[0]) < window_progress:
-                    paddle_still = need  # stalled: the drive ends below
-                elif ex * ex + ey * ey < lin2 and done:
-                    paddle_still += 1
-                else:
-                    paddle_still = 0
-                    last = None
-                    others_still = 0
-                    continue
-            now = []
-            for b in movable:
-                pos = get_pos(b)
-                now.append((pos.x, pos.y, get_angle(b)))
-            if last is not None:
-                for (x0, y0, a0), (x1, y1, a1) in zip(last, now, strict=True):
-                    if (x1 - x0) ** 2 + (y1 - y0) ** 2 >= lin2 or abs(a1 - a0) >= ang_tol:
-                        others_still = 0
-                        break
-                else:
-                    others_still += 1
-            last = now
-            if driving:
-                if paddle_still >= need:
-                    driving = False
-                    if drive is not None:
-                        set_max_bias(drive, 0.0)
-                    else:
-                        constraints.extend(track.brake(space, static))
-                    travel = (last_x - px) * dx + (last_y - py) * dy
-                    if watch is not None:
-                        watch(None)  # the drive's end
-            elif others_still >= need:
-                break
-        if driving:  # capped while driving
-            travel = (last_x - px) * dx + (last_y - py) * dy
-        poses = []
-        for (obj, _), b in zip(state.poses, movable, strict=True):
-            pos = get_pos(b)
-            poses.append((obj, (pos.x, pos.y, get_angle(b))))
-        pos = get_pos(paddle)
-        paddle_pose = (pos.x, pos.y, get_angle(paddle))
-    finally:
-        lib.cpSpaceFree(space)
-        for shape in shapes:
+    def free(self) -> None:
+        """Free the space, then everything that was added to it."""
+        lib.cpSpaceFree(self.space)
+        for shape in self.shapes:
             lib.cpShapeFree(shape)
-        for constraint in constraints:
+        for constraint in self.constraints:
             lib.cpConstraintFree(constraint)
-        for body in bodies:
+        for body in self.bodies:
             lib.cpBodyFree(body)
 
-    if overlap > s.overlap_tolerance:
-        status = StepStatus.OVERLAP
-    elif capped:
-        status = StepStatus.NOT_AT_REST
-    else:
-        status = StepStatus.OK
-    return _finish(
-        compiled,
-        tuple(poses),
-        status,
-        sim_time=steps * dt,
-        steps=steps,
-        manipulator_travel=travel,
-        overlap=overlap,
-        manipulator_pose=paddle_pose,
-    )
+
+def _moment(rho: float, part_moments) -> float:
+    """The moment of a body of density ``rho``: the sum over its convex parts, in order."""
+    moment = 0.0
+    for area_i, unit_moment in part_moments:
+        moment += rho * area_i * unit_moment
+    return moment
+
+
+def _add_movable_bodies(
+    scene: _Scene, compiled: _Compiled, state: WorldState, noise: ActionNoise, s: PhysicsSettings
+) -> list:
+    """Add the bodies of ``state``, in its order, and return them: fixtures clamped
+    (kinematic), parts and resting manipulators dynamic at the draw's density with table
+    friction (a pivot and a gear joint to the static body with no bias, clipped at the
+    Coulomb force and torque)."""
+    mu = float(noise.friction)
+    g = s.gravity
+    static = scene.static
+    movable = []
+    for obj, (x, y, th) in state.poses:
+        body_def = compiled.bodies[obj]
+        clamped = body_def.kind is ObjectKind.FIXTURE
+        rho = (
+            noise.manipulator_density
+            if body_def.kind is ObjectKind.MANIPULATOR
+            else noise.part_density
+        )
+        mass = rho * body_def.area
+        if clamped:
+            # Clamped to the table (see the module docstring): a kinematic body that never
+            # moves, with no table friction to model.
+            body = lib.cpBodyNewKinematic()
+        else:
+            body = lib.cpBodyNew(mass, _moment(rho, body_def.part_moments))
+        scene.add_body(body, body_def, x, y, th)
+        movable.append(body)
+        if clamped:
+            continue
+        pivot = lib.cpPivotJointNew2(static, body, (0.0, 0.0), (0.0, 0.0))
+        lib.cpConstraintSetMaxBias(pivot, 0.0)
+        lib.cpConstraintSetMaxForce(pivot, mu * mass * g)
+        scene.add_constraint(pivot)
+        gear = lib.cpGearJointNew(static, body, 0.0, 1.0)
+        lib.cpConstraintSetMaxBias(gear, 0.0)
+        lib.cpConstraintSetMaxForce(gear, mu * g * rho * body_def.abs_r)
+        scene.add_constraint(gear)
+    return movable
+
+
+@dataclass(frozen=True)
+class _Paddle:
+    """The manipulator of one push as put down: its body, mass and moment (infinite under the
+    servo), radius, the (noisy) approach pose and its push direction at that pose."""
+
+    body: object
+    mass: float
+    moment: float
+    radius: float
+    pose: Pose
+    direction: tuple[float, float]
+
+
+def _put_down_paddle(
+    scene: _Scene, paddle_def, action: Push, noise: ActionNoise, compliant: bool
+) -> _Paddle:
+    """Add the manipulator at the approach pose plus the draw's offset, with no table friction:
+    its own moment under the compliant controller (the wrist can turn), infinite otherwise."""
+    ox, oy, oth = noise.pose_offset
+    px, py, pth = action.pose
+    px, py, pth = float(px) + ox, float(py) + oy, float(pth) + oth
+    rho_m = noise.manipulator_density
+    mass = rho_m * paddle_def.area
+    moment = _moment(rho_m, paddle_def.part_moments) if compliant else math.inf
+    body = lib.cpBodyNew(mass, moment)
+    scene.add_body(body, paddle_def, px, py, pth)
+    direction = rotate(paddle_def.push_direction, pth)
+    return _Paddle(body, mass, moment, paddle_def.radius, (px, py, pth), direction)
+
+
+def _settle(
+    scene: _Scene,
+    compiled: _Compiled,
+    state: WorldState,
+    manipulator: str,
+    pose: Pose,
+    s: PhysicsSettings,
+    step,
+) -> float:
+    """Run ``settle_steps`` undriven steps and return the deepest overlap at the landing: in the
+    contacts the engine built, and of the paddle in the geometry (the contacts miss a
+    concentric landing); 0 when there are no settle steps."""
+    space, dt = scene.space, s.dt
+    for _ in range(s.settle_steps):
+        step(space, dt)
+    if not s.settle_steps:
+        return 0.0
+    _, landing = compiled.depths.deepest_at(state, manipulator, pose)
+    return max(_deepest_overlap(space), landing)
+
+
+def _start_drive(
+    scene: _Scene,
+    compiled: _Compiled,
+    controller: Controller,
+    paddle: _Paddle,
+    distance: float,
+    s: PhysicsSettings,
+    step,
+) -> _Servo | _Tracking:
+    """The problem's controller driving ``paddle`` ``distance`` along its push direction,
+    clipped at the controller's force or the problem's force clip."""
+    force = _force_clip(compiled.problem, compiled.parts_area, s)
+    if controller.kind is ControllerKind.COMPLIANT:
+        return _Tracking(controller, s, paddle, force, distance, step)
+    return _Servo(scene, controller, s, paddle, force, distance, step)
+
+
+class _Servo:
+    """The servo controller of one push (module docstring): a pivot joint toward the reference
+    point, solved with the contacts on pymunk's side."""
+
+    def __init__(
+        self,
+        scene: _Scene,
+        controller: Controller,
+        settings: PhysicsSettings,
+        paddle: _Paddle,
+        force: float,
+        distance: float,
+        step,
+    ) -> None:
+        if controller.force is not None:
+            force = controller.force
+        px, py, _ = paddle.pose
+        dx, dy = paddle.direction
+        ref = (px + distance * dx, py + distance * dy)
+        self.joint = _add_drive(
+            scene.space, scene.static, paddle.body, ref, settings, force, controller.speed
+        )
+        scene.constraints.append(self.joint)
+        self.speed = settings.push_speed if controller.speed is None else controller.speed
+        self.space = scene.space
+        self.dt = settings.dt
+        self.step = step
+
+    def advance(self, n: int) -> None:
+        """Run ``n`` steps (the joint drives the paddle)."""
+        step, space, dt = self.step, self.space, self.dt
+        for _ in range(n):
+            step(space, dt)
+
+    def still(self, tol: float) -> bool:
+        """Always: the servo's paddle cannot turn, its position alone is judged."""
+        return True
+
+    def stop(self, scene: _Scene) -> None:
+        """Stop driving: the joint with no bias holds the paddle where it is."""
+        lib.cpConstraintSetMaxBias(self.joint, 0.0)
 
 
 class _Tracking:
@@ -726,24 +726,24 @@ class _Tracking:
         self,
         controller: Controller,
         settings: PhysicsSettings,
-        paddle,
-        mass: float,
-        moment: float,
-        radius: float,
+        paddle: _Paddle,
         default_force: float,
-        start: Pose,
-        direction: tuple[float, float],
+        distance: float,
         step=lib.cpSpaceStep,
     ) -> None:
-        gains = compliant_gains(controller, settings, mass, moment, radius, default_force)
-        self.kp, self.kd, self.kp_a, self.kd_a, self.force, self.torque, self.speed = gains
+        gains = compliant_gains(
+            controller, settings, paddle.mass, paddle.moment, paddle.radius, default_force
+        )
+        self.kp, self.kd = gains.kp, gains.kd
+        self.kp_a, self.kd_a = gains.kp_angle, gains.kd_angle
+        self.force, self.torque, self.speed = gains.force, gains.torque, gains.speed
         self.space_dt = settings.dt
-        self.paddle = paddle
-        self.start = start
-        self.direction = direction
-        self.distance = 0.0
+        self.paddle = paddle.body
+        self.start = paddle.pose
+        self.direction = paddle.direction
+        self.distance = distance
         self.k = 0  # steps driven
-        self.last_angle = start[2]
+        self.last_angle = paddle.pose[2]
         self.step = step
 
     def advance(self, n: int) -> None:
@@ -781,18 +781,204 @@ class _Tracking:
         self.last_angle = angle
         return self.k * self.speed * self.space_dt >= self.distance and turned < tol
 
-    def brake(self, space, static) -> list:
+    def stop(self, scene: _Scene) -> None:
         """Stop driving: hold the paddle where it is (pivot and gear with no bias, clipped at
         the force and torque clips) while the other bodies come to rest."""
-        pivot = lib.cpPivotJointNew(static, self.paddle, lib.cpBodyGetPosition(self.paddle))
+        pivot = lib.cpPivotJointNew(scene.static, self.paddle, lib.cpBodyGetPosition(self.paddle))
         lib.cpConstraintSetMaxBias(pivot, 0.0)
         lib.cpConstraintSetMaxForce(pivot, self.force)
-        lib.cpSpaceAddConstraint(space, pivot)
-        gear = lib.cpGearJointNew(static, self.paddle, 0.0, 1.0)
+        lib.cpSpaceAddConstraint(scene.space, pivot)
+        gear = lib.cpGearJointNew(scene.static, self.paddle, 0.0, 1.0)
         lib.cpConstraintSetMaxBias(gear, 0.0)
         lib.cpConstraintSetMaxForce(gear, self.torque)
-        lib.cpSpaceAddConstraint(space, gear)
-        return [pivot, gear]
+        lib.cpSpaceAddConstraint(scene.space, gear)
+        scene.constraints.extend((pivot, gear))
+
+
+class _PushRun:
+    """The stepping of one push after the settle, in rest checks every ``interval`` steps
+    (module docstring, "Rest"): :meth:`drive_until_still`, then :meth:`hold_until_rest`.
+
+    The whole push is capped at :meth:`PhysicsSettings.cap_steps` for the travel across the
+    table at most (a push commanded further, which a plan file may say, ends against a wall or
+    off the table by then); a push not at rest ``stuck_time`` after its set point's end gets
+    ``stuck_iterations`` from then on, and its drive also ends once the paddle's progress along
+    the push over the last ``stall_window`` is below the rest speed (chatter is not motion).
+    After the run, ``steps`` counts every step taken (the settle's included), ``capped`` says
+    whether the cap was hit and ``travel`` is how far the paddle moved along its push direction
+    while it was driven.
+    """
+
+    def __init__(
+        self,
+        scene: _Scene,
+        compiled: _Compiled,
+        paddle: _Paddle,
+        drive: _Servo | _Tracking,
+        movable: list,
+        distance: float,
+        s: PhysicsSettings,
+        step,
+        watch: Callable[[list], None] | None,
+    ) -> None:
+        self.scene = scene
+        self.paddle = paddle
+        self.drive = drive
+        self.s = s
+        self.step = step
+        self.watch = watch
+        self.interval = s.interval_steps
+        setpoint_end = distance / drive.speed
+        crossing = push_crossing(compiled.table.size, paddle.radius)
+        self.max_steps = s.cap_steps(min(distance, crossing) / drive.speed)
+        if s.stuck_time > 0.0:
+            self.stuck_at = math.ceil((setpoint_end + s.stuck_time) / s.dt)
+        else:
+            self.stuck_at = self.max_steps + 1
+        self.stuck = False
+        self.steps = s.settle_steps
+        self.capped = False
+        self.travel = 0.0
+        self.rest = _RestCount(movable, s.rest_linear_tol, s.rest_angular_tol)
+
+    def _escalate_when_stuck(self) -> None:
+        """From ``stuck_at`` on, solve with ``stuck_iterations`` (once)."""
+        if self.steps >= self.stuck_at:
+            lib.cpSpaceSetIterations(self.scene.space, self.s.stuck_iterations)
+            self.stuck_at = self.max_steps + 1
+            self.stuck = True
+
+    def _hold(self, n: int) -> None:
+        step, space, dt = self.step, self.scene.space, self.s.dt
+        for _ in range(n):
+            step(space, dt)
+
+    def drive_until_still(self) -> bool:
+        """Drive the paddle until it was still ``rest_checks`` checks in a row (position and,
+        compliant, angle, with its set point at its end) or stalled, then stop driving (the
+        drive becomes a brake); return whether that happened before the cap. The other bodies
+        are watched from the first check at which the paddle is still, so that the check that
+        stops the drive can count toward their rest."""
+        s, drive, interval = self.s, self.drive, self.interval
+        need = s.rest_checks
+        lin2 = s.rest_linear_tol * s.rest_linear_tol
+        ang_tol = s.rest_angular_tol
+        body = self.paddle.body
+        px, py, _ = self.paddle.pose
+        dx, dy = self.paddle.direction
+        window = round(s.stall_window / (interval * s.dt)) if s.stall_window > 0.0 else 0
+        window_progress = s.rest_linear_tol * window
+        progress: deque[float] = deque(maxlen=window + 1)
+        rest = self.rest
+        paddle_still = 0
+        last_x, last_y = px, py
+        while True:
+            self._escalate_when_stuck()
+            if self.steps + interval > self.max_steps:
+                drive.advance(self.max_steps - self.steps)
+                self.steps = max(self.steps, self.max_steps)
+                self.capped = True
+                pos = lib.cpBodyGetPosition(body)
+                self.travel = (pos.x - px) * dx + (pos.y - py) * dy
+                return False
+            drive.advance(interval)
+            self.steps += interval
+            pos = lib.cpBodyGetPosition(body)
+            ex, ey = pos.x - last_x, pos.y - last_y
+            last_x, last_y = pos.x, pos.y
+            # The compliant paddle must also have stopped turning, its set point at its end.
+            done = drive.still(ang_tol)
+            if self.stuck and window:
+                progress.append(pos.x * dx + pos.y * dy)
+            if len(progress) > window and abs(progress[-1] - progress[0]) < window_progress:
+                paddle_still = need  # stalled: the drive ends below
+            elif ex * ex + ey * ey < lin2 and done:
+                paddle_still += 1
+            else:
+                paddle_still = 0
+                rest.reset()
+                continue
+            rest.check()
+            if paddle_still >= need:
+                drive.stop(self.scene)
+                self.travel = (last_x - px) * dx + (last_y - py) * dy
+                if self.watch is not None:
+                    self.watch(None)  # the drive's end
+                return True
+
+    def hold_until_rest(self) -> None:
+        """With the paddle held, step until every other body was still ``rest_checks`` checks
+        in a row (counting from :meth:`drive_until_still`), or the cap."""
+        interval, need, rest = self.interval, self.s.rest_checks, self.rest
+        while True:
+            self._escalate_when_stuck()
+            if self.steps + interval > self.max_steps:
+                self._hold(self.max_steps - self.steps)
+                self.steps = max(self.steps, self.max_steps)
+                self.capped = True
+                return
+            self._hold(interval)
+            self.steps += interval
+            rest.check()
+            if rest.still >= need:
+                return
+
+
+class _RestCount:
+    """How many rest checks in a row ``bodies`` were all still: each moved less than
+    ``linear_tol`` and turned less than ``angular_tol`` since the previous check (the first
+    check after a reset only records the poses)."""
+
+    def __init__(self, bodies: list, linear_tol: float, angular_tol: float) -> None:
+        self.bodies = bodies
+        self.lin2 = linear_tol * linear_tol
+        self.ang_tol = angular_tol
+        self.last: list | None = None
+        self.still = 0
+
+    def reset(self) -> None:
+        """Forget the poses and the count."""
+        self.last = None
+        self.still = 0
+
+    def check(self) -> None:
+        """Compare the bodies' poses with the previous check's and count."""
+        get_pos, get_angle = lib.cpBodyGetPosition, lib.cpBodyGetAngle
+        now = []
+        for b in self.bodies:
+            pos = get_pos(b)
+            now.append((pos.x, pos.y, get_angle(b)))
+        last = self.last
+        if last is not None:
+            lin2, ang_tol = self.lin2, self.ang_tol
+            for (x0, y0, a0), (x1, y1, a1) in zip(last, now, strict=True):
+                if (x1 - x0) ** 2 + (y1 - y0) ** 2 >= lin2 or abs(a1 - a0) >= ang_tol:
+                    self.still = 0
+                    break
+            else:
+                self.still += 1
+        self.last = now
+
+
+@dataclass(frozen=True)
+class CompliantGains:
+    """The compliant controller's gains and clips for one paddle, resolved
+    (:func:`compliant_gains`)."""
+
+    kp: float
+    """Proportional gain per axis (force per inch of tracking error)."""
+    kd: float
+    """Derivative gain per axis: ``damping_ratio * sqrt(4 m Kp)``."""
+    kp_angle: float
+    """Proportional gain on the angle (torque per radian)."""
+    kd_angle: float
+    """Derivative gain on the angle: ``damping_ratio * sqrt(4 I Kp_angle)``."""
+    force: float
+    """Clip of the force on each axis."""
+    torque: float
+    """Clip of the torque."""
+    speed: float
+    """Speed of the set point along the push line (in/s)."""
 
 
 def compliant_gains(
@@ -802,14 +988,14 @@ def compliant_gains(
     moment: float,
     radius: float,
     default_force: float,
-) -> tuple[float, float, float, float, float, float, float]:
-    """``(Kp, Kd, Kp_angle, Kd_angle, force clip, torque clip, speed)`` of the compliant
-    controller for a paddle of ``mass``, ``moment`` and ``radius`` (the largest distance of
-    its outline from its centroid), the ``None`` fields of ``controller`` at their defaults
-    (:class:`~arrange_up.model.problem.Controller`): ``Kp_angle = Kp radius^2``, so that a
-    force at the paddle's end moves that end about as far by turning it as a force at its
-    centre moves the centre (a wrist as stiff as the arm), and ``torque = force * radius``;
-    ``Kd = damping_ratio * sqrt(4 m Kp)`` and likewise on the angle."""
+) -> CompliantGains:
+    """The gains and clips of the compliant controller for a paddle of ``mass``, ``moment`` and
+    ``radius`` (the largest distance of its outline from its centroid), the ``None`` fields of
+    ``controller`` at their defaults (:class:`~arrange_up.model.problem.Controller`), the force
+    clip at ``default_force``: ``Kp_angle = Kp radius^2``, so that a force at the paddle's end
+    moves that end about as far by turning it as a force at its centre moves the centre (a
+    wrist as stiff as the arm), and ``torque = force * radius``; ``Kd = damping_ratio *
+    sqrt(4 m Kp)`` and likewise on the angle."""
     kp = controller.kp
     kp_a = kp * radius * radius if controller.kp_angle is None else controller.kp_angle
     force = default_force if controller.force is None else controller.force
@@ -818,7 +1004,7 @@ def compliant_gains(
     zeta = settings.damping_ratio
     kd = zeta * math.sqrt(4.0 * mass * kp)
     kd_a = zeta * math.sqrt(4.0 * moment * kp_a)
-    return kp, kd, kp_a, kd_a, force, torque, speed
+    return CompliantGains(kp, kd, kp_a, kd_a, force, torque, speed)
 
 
 #: The largest ``sqrt(K / m) * dt`` (and ``sqrt(K_angle / I) * dt``) at which the compliant
@@ -827,15 +1013,25 @@ def compliant_gains(
 STABLE_RATE = 0.5
 
 
+class StiffManipulator(NamedTuple):
+    """A manipulator the compliant controller is too stiff for (:func:`stiff_manipulators`)."""
+
+    name: str
+    rate: float
+    """The larger of ``sqrt(Kp / m) dt`` and ``sqrt(Kp_angle / I) dt``."""
+    kp_max: float
+    """The largest ``kp`` that keeps the rate at :data:`STABLE_RATE`."""
+
+
 def stiff_manipulators(
     problem: ArrangementProblem, settings: PhysicsSettings = DEFAULT_SETTINGS
-) -> list[tuple[str, float, float]]:
-    """The manipulators the problem's compliant controller is too stiff for at the time step:
-    ``(name, rate, kp_max)``, ``rate`` the larger of ``sqrt(Kp / m) dt`` and
-    ``sqrt(Kp_angle / I) dt`` at the lightest manipulator density, above :data:`STABLE_RATE`,
-    and ``kp_max`` the largest ``kp`` (internal units) that keeps both at it when the angle
-    gain is its default ``kp r^2`` (with an explicit ``kp_angle``, the linear bound alone).
-    Empty under the servo."""
+) -> list[StiffManipulator]:
+    """The manipulators the problem's compliant controller is too stiff for at the time step,
+    as :class:`StiffManipulator` ``(name, rate, kp_max)``: ``rate`` the larger of
+    ``sqrt(Kp / m) dt`` and ``sqrt(Kp_angle / I) dt`` at the lightest manipulator density,
+    above :data:`STABLE_RATE`, and ``kp_max`` the largest ``kp`` (internal units) that keeps
+    both at it when the angle gain is its default ``kp r^2`` (with an explicit ``kp_angle``,
+    the linear bound alone). Empty under the servo."""
     controller = problem.controller
     if controller.kind is not ControllerKind.COMPLIANT:
         return []
@@ -847,16 +1043,15 @@ def stiff_manipulators(
         body = compiled.bodies[spec.name]
         mass = rho * body.area
         moment = sum(rho * area * unit for area, unit in body.part_moments)
-        kp, _, kp_a, _, _, _, _ = compliant_gains(
-            controller, settings, mass, moment, body.radius, force
-        )
+        gains = compliant_gains(controller, settings, mass, moment, body.radius, force)
+        kp, kp_a = gains.kp, gains.kp_angle
         dt = settings.dt
         rate = max(math.sqrt(kp / mass) * dt, math.sqrt(kp_a / moment) * dt)
         if rate > STABLE_RATE:
             limit = mass * (STABLE_RATE / dt) ** 2
             if controller.kp_angle is None:
                 limit = min(limit, moment / body.radius**2 * (STABLE_RATE / dt) ** 2)
-            found.append((spec.name, rate, limit))
+            found.append(StiffManipulator(spec.name, rate, limit))
     return found
 
 

@@ -39,7 +39,7 @@ from arrange_up.repair.records import (
     RepairStats,
     RepairStatus,
     StepRecord,
-    StepStatus,
+    StepRepairStatus,
     plan_groups,
 )
 from arrange_up.repair.repairer import (
@@ -76,7 +76,7 @@ __all__ = [
     "RepairStatus",
     "StepRecord",
     "StepScores",
-    "StepStatus",
+    "StepRepairStatus",
     "nominal_plans",
     "plan_groups",
     "repair_plan",

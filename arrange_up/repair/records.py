@@ -39,7 +39,7 @@ class RepairStatus(StrEnum):
     """The wall-clock limit was reached."""
 
 
-class StepStatus(StrEnum):
+class StepRepairStatus(StrEnum):
     """How the repair of one nominal step ended (its JSON form is the string)."""
 
     OK = "ok"
@@ -67,7 +67,7 @@ class StepRecord:
     kind: str
     nominal: Action
     actions: tuple[Action, ...]
-    status: str = StepStatus.OK
+    status: str = StepRepairStatus.OK
     reason: str = ""
     fixture: str | None = None
     pose: Pose | None = None
@@ -110,7 +110,7 @@ class StepRecord:
                 "push",
                 push,
                 (),
-                status=StepStatus.FAILED,
+                status=StepRepairStatus.FAILED,
                 reason="every valid candidate would make the plan fail nominally, or is a "
                 "fixture scoring worse than the bare push (no fixture "
                 f"and {len(placements) - common['blocked']} placements, multipliers "
@@ -124,7 +124,7 @@ class StepRecord:
                 "push",
                 push,
                 (),
-                status=StepStatus.FAILED,
+                status=StepRepairStatus.FAILED,
                 reason="every candidate is invalid (no fixture and "
                 f"{len(placements) - common['blocked']} placements, multipliers "
                 f"{', '.join(f'{m:g}' for m in MULTIPLIERS)}): " + "; ".join(reasons),

@@ -137,7 +137,7 @@ from arrange_up.repair.records import (
     TIMEOUT,
     RepairResult,
     StepRecord,
-    StepStatus,
+    StepRepairStatus,
     plan_groups,
 )
 from arrange_up.transitions.particles import DeterministicSemantics, ParticleSemantics
@@ -254,7 +254,7 @@ def repair_plan(
                     type(action).__name__.lower(),
                     action,
                     (action,),
-                    status=StepStatus.OK if after is not None else StepStatus.FAILED,
+                    status=StepRepairStatus.OK if after is not None else StepRepairStatus.FAILED,
                     reason=reason,
                     simulations=repairer.simulations - sims_before,
                     elapsed=time.monotonic() - step_started,

@@ -122,7 +122,7 @@ def make_semantics(
     """Instantiate the named semantics for ``problem``.
 
     ``model`` selects the learned model of a semantics that has one (``cbst``: a shipped name
-    or a model card's path, see :func:`arrange_up.cbst.model.load_model`); ``None`` leaves the
+    or a model card's path, see :func:`arrange_up.cbst.store.load_model`); ``None`` leaves the
     semantics' default.
 
     Raises ``ValueError`` naming the registered semantics when ``name`` is unknown, and when a

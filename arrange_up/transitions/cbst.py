@@ -79,7 +79,7 @@ from arrange_up.cbst.contact_graph import (
 from arrange_up.cbst.data import DEFAULT_GENERATION, GenerationSettings
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
-from arrange_up.cbst.model import DEFAULT_MODEL
+from arrange_up.cbst.store import DEFAULT_MODEL
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import (

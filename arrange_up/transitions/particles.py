@@ -68,7 +68,7 @@ from arrange_up.model.world import (
     nominal_noise,
 )
 from arrange_up.parallel import local_executor
-from arrange_up.physics.simulation import DEFAULT_SETTINGS, StepStatus, simulate
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, SimulationStatus, simulate
 
 #: Extra reach of a push beyond its commanded distance, and sideways drift allowance (inches).
 SWEEP_MARGIN = 0.3
@@ -82,8 +82,9 @@ _ANY_PUSH = Push("-", (0.0, 0.0, 0.0), 0.0)
 
 
 class Simulated(NamedTuple):
-    """One particle's simulated push: its status (a :class:`StepStatus` value), the objects it
-    put off the table, and the poses of the simulated objects afterwards (also when it failed)."""
+    """One particle's simulated push: its status (a :class:`SimulationStatus` value), the
+    objects it put off the table, and the poses of the simulated objects afterwards (also when
+    it failed)."""
 
     status: str
     off_table: tuple[str, ...]
@@ -91,26 +92,26 @@ class Simulated(NamedTuple):
 
     @property
     def ok(self) -> bool:
-        return self.status == StepStatus.OK
+        return self.status == SimulationStatus.OK
 
     def reason(self) -> str:
         """Why the push failed, as a sentence about "a particle's push"."""
-        if self.status == StepStatus.OFF_TABLE:
+        if self.status == SimulationStatus.OFF_TABLE:
             return f"a particle's push put {', '.join(self.off_table)} off the table"
-        if self.status == StepStatus.NOT_AT_REST:
+        if self.status == SimulationStatus.NOT_AT_REST:
             return "a particle's push did not come to rest"
-        if self.status == StepStatus.OVERLAP:
+        if self.status == SimulationStatus.OVERLAP:
             return "a particle's push started with shapes overlapping"
         return f"a particle's push failed ({self.status})"
 
     def refusal(self) -> str:
         """Why a transition whose push failed so is refused: a short sentence for the planner's
         reason line (a key of :attr:`ParticleSemantics.reasons`), naming the cause."""
-        if self.status == StepStatus.OFF_TABLE:
+        if self.status == SimulationStatus.OFF_TABLE:
             return f"a push left {', '.join(self.off_table)} off the table"
-        if self.status == StepStatus.NOT_AT_REST:
+        if self.status == SimulationStatus.NOT_AT_REST:
             return NOT_AT_REST_REFUSAL
-        if self.status == StepStatus.OVERLAP:
+        if self.status == SimulationStatus.OVERLAP:
             return OVERLAP_REFUSAL
         return f"a push failed in the simulation ({self.status})"
 

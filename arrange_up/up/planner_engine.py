@@ -302,7 +302,7 @@ def _check_params(
             )
         # Lazy: the model room imports scikit-learn, which the engines need only for cbst
         # (at module level it would add 0.13 s, measured, to importing this module).
-        from arrange_up.cbst.model import load_model
+        from arrange_up.cbst.store import load_model
 
         try:
             load_model(model)  # a model that does not load is refused when the engine is made

@@ -21,14 +21,8 @@ from arrange_up.cbst.data import (
     generate_dataset,
 )
 from arrange_up.cbst.features import TARGET_NAMES
-from arrange_up.cbst.model import (
-    SHIPPED_MODELS,
-    load_model,
-    model_dir,
-    rescore_model,
-    save_model,
-    train_cbst,
-)
+from arrange_up.cbst.model import rescore_model, train_cbst
+from arrange_up.cbst.store import SHIPPED_MODELS, load_model, model_dir, save_model
 from arrange_up.cli import main
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.domains import load

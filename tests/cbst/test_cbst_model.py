@@ -13,7 +13,8 @@ from sklearn.utils.estimator_checks import check_estimator
 
 from arrange_up.cbst.fast_forest import FastForest
 from arrange_up.cbst.features import FEATURE_NAMES, TARGET_NAMES, THESIS_TEST_RMSE, Domain
-from arrange_up.cbst.model import CBSTRegressor, load_model, save_model, tune
+from arrange_up.cbst.model import CBSTRegressor, tune
+from arrange_up.cbst.store import load_model, save_model
 
 # Checks scikit-learn itself skips in this environment (not applicable here):
 #  * check_array_api_input: needs SCIPY_ARRAY_API=1 and an array-API library; the model is
@@ -179,19 +180,19 @@ def test_load_by_name_from_an_installed_wheel_layout(tmp_path, monkeypatch):
     """A wheel carries semantics/ as arrange_up/_shipped/semantics/: found there first."""
     import shutil
 
-    from arrange_up.cbst import model as model_module
+    from arrange_up.cbst import store
     from arrange_up.io import resources
 
     shipped = tmp_path / "_shipped" / "semantics" / "cbst"
     shipped.mkdir(parents=True)
-    source = model_module.model_dir()  # the checkout's, or the installed wheel's
+    source = store.model_dir()  # the checkout's, or the installed wheel's
     for suffix in (".json", ".npz"):
         shutil.copy(source / f"servo{suffix}", shipped / f"wheel-only{suffix}")
     card = json.loads((shipped / "wheel-only.json").read_text())
     card["arrays"]["file"] = "wheel-only.npz"
     (shipped / "wheel-only.json").write_text(json.dumps(card))
     monkeypatch.setattr(resources, "WHEEL_DIR", tmp_path / "_shipped")
-    assert model_module.model_dir() == shipped
+    assert store.model_dir() == shipped
     model = load_model("wheel-only")
     assert model.card_["arrays"]["file"] == "wheel-only.npz"
 

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import arrange_up.cbst.model as model_module
+import arrange_up.cbst.store as store
 from arrange_up.cbst.features import FEATURE_NAMES, Domain
-from arrange_up.cbst.model import CBSTRegressor, load_model, model_dir, save_model
+from arrange_up.cbst.model import CBSTRegressor
+from arrange_up.cbst.store import load_model, model_dir, save_model
 from arrange_up.io.domains import load as load_domain
 from arrange_up.model.problem import Controller, ControllerKind
 from arrange_up.planning.planner import plan
@@ -113,7 +114,7 @@ def test_an_unsound_model_is_one_value_error_naming_the_file(tiny, tmp_path, edi
 
 def test_an_array_unpacking_beyond_the_limit_is_refused(tiny, tmp_path, monkeypatch):
     card_path = _saved(tiny, tmp_path)
-    monkeypatch.setattr(model_module, "MAX_ARRAY_BYTES", 64)
+    monkeypatch.setattr(store, "MAX_ARRAY_BYTES", 64)
     with pytest.raises(ValueError, match=r"tiny\.npz: arrays .* unpack to more than 64 bytes"):
         load_model(card_path)
 

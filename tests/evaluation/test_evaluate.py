@@ -188,7 +188,7 @@ def test_off_table_and_not_at_rest_are_told_apart(monkeypatch):
     def capped(problem, state, action, noise=None, settings=physics.DEFAULT_SETTINGS):
         outcome = real(problem, state, action, noise, settings)
         if isinstance(action, Push):
-            return replace(outcome, status=physics.StepStatus.NOT_AT_REST)
+            return replace(outcome, status=physics.SimulationStatus.NOT_AT_REST)
         return outcome
 
     monkeypatch.setattr(physics, "simulate", capped)

@@ -23,7 +23,7 @@ from arrange_up.model.problem import (
 from arrange_up.model.world import ActionNoise, Push, WorldState
 from arrange_up.physics.bench import scene
 from arrange_up.physics.settings import DEFAULT_SETTINGS
-from arrange_up.physics.simulation import StepStatus, simulate, simulate_watched
+from arrange_up.physics.simulation import SimulationStatus, simulate, simulate_watched
 
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
 FRESH = Path(__file__).resolve().parents[1] / "problems" / "fresh"
@@ -133,16 +133,14 @@ def test_controller_mapping_errors(mapping, message):
 def test_default_angle_gain_makes_the_wrist_as_stiff_as_the_arm():
     from arrange_up.physics.simulation import DEFAULT_SETTINGS, compliant_gains
 
-    kp, kd, kp_a, kd_a, force, torque, speed = compliant_gains(
-        COMPLIANT, DEFAULT_SETTINGS, 0.15, 0.08, 1.25, 400.0
-    )
+    gains = compliant_gains(COMPLIANT, DEFAULT_SETTINGS, 0.15, 0.08, 1.25, 400.0)
     # a force F at the paddle's end (1.25 in out) turns it by F r / Kp_angle, moving the end
     # F r^2 / Kp_angle: as far as F moves the centre, F / Kp
-    assert 1.25 * 1.25 / kp_a == pytest.approx(1.0 / kp)
-    assert kd == pytest.approx(math.sqrt(4 * 0.15 * kp))
-    assert kd_a == pytest.approx(math.sqrt(4 * 0.08 * kp_a))
-    assert (force, speed) == (400.0, DEFAULT_SETTINGS.push_speed)
-    assert torque == pytest.approx(400.0 * 1.25)
+    assert 1.25 * 1.25 / gains.kp_angle == pytest.approx(1.0 / gains.kp)
+    assert gains.kd == pytest.approx(math.sqrt(4 * 0.15 * gains.kp))
+    assert gains.kd_angle == pytest.approx(math.sqrt(4 * 0.08 * gains.kp_angle))
+    assert (gains.force, gains.speed) == (400.0, DEFAULT_SETTINGS.push_speed)
+    assert gains.torque == pytest.approx(400.0 * 1.25)
 
 
 def test_plan_files_record_the_controller():
@@ -174,9 +172,9 @@ def test_a_wedged_compliant_push_comes_to_rest_with_more_solver_iterations():
         manipulator_density=0.4,
     )
     settled = simulate(problem, state, push, noise)
-    assert settled.status is StepStatus.OK
+    assert settled.status is SimulationStatus.OK
     assert settled.sim_time < 2.5
     x, y, _ = settled.state.as_dict()["A"]
     assert abs(x - 5.41) < 0.02 and abs(y - 0.59) < 0.02
     chattering = simulate(problem, state, push, noise, replace(DEFAULT_SETTINGS, stuck_time=0.0))
-    assert chattering.status is StepStatus.NOT_AT_REST
+    assert chattering.status is SimulationStatus.NOT_AT_REST

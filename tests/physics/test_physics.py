@@ -31,7 +31,7 @@ from arrange_up.physics.bodies import _abs_r_integral
 from arrange_up.physics.simulation import (
     DEFAULT_SETTINGS,
     PhysicsSettings,
-    StepStatus,
+    SimulationStatus,
     _drive_trajectory,
     pd_gains,
     push_force,
@@ -95,7 +95,7 @@ def test_block_pushed_against_wall_ends_against_it():
     problem = make_problem(1)
     state = state_of(problem, b0=(7.0, 2.5, 0.0))
     outcome = simulate(problem, state, push_east(7.0, 2.5, 5.0))
-    assert outcome.status is StepStatus.OK
+    assert outcome.status is SimulationStatus.OK
     x, y, theta = outcome.state.pose("b0")
     assert x == pytest.approx(10.0 - 0.5, abs=0.02)
     assert y == pytest.approx(2.5, abs=0.02)
@@ -171,7 +171,7 @@ def test_part_pushed_off_an_open_edge_is_off_table():
     problem = make_problem(1, walls=("left", "bottom", "top"))
     state = state_of(problem, b0=(8.5, 2.5, 0.0))
     outcome = simulate(problem, state, push_east(8.5, 2.5, 2.5))
-    assert outcome.status is StepStatus.OFF_TABLE
+    assert outcome.status is SimulationStatus.OFF_TABLE
     assert outcome.off_table == ("b0",)
     assert outcome.state.pose("b0")[0] > 10.0
     assert not outcome.ok
@@ -185,10 +185,10 @@ def test_rest_cap_reports_not_at_rest():
     # end plus travel_margin
     settings = PhysicsSettings(max_time=0.05, travel_margin=0.05)
     capped = simulate(problem, state, push, settings=settings)
-    assert capped.status is StepStatus.NOT_AT_REST
+    assert capped.status is SimulationStatus.NOT_AT_REST
     assert capped.sim_time == pytest.approx(2.0 / 3.0 + 0.05, abs=DEFAULT_SETTINGS.dt)
     normal = simulate(problem, state, push)
-    assert normal.status is StepStatus.OK
+    assert normal.status is SimulationStatus.OK
     assert 0.5 < normal.sim_time < 3.0
 
 
@@ -198,7 +198,7 @@ def test_a_long_push_is_not_cut_off_before_it_could_arrive():
     problem = dataclasses.replace(make_problem(1), table=Table((120.0, 5.0)))
     state = state_of(problem, b0=(10.0, 2.5, 0.0))
     outcome = simulate(problem, state, push_east(10.0, 2.5, 112.0))
-    assert outcome.status is StepStatus.OK, outcome.status
+    assert outcome.status is SimulationStatus.OK, outcome.status
     assert outcome.state.pose("b0")[0] == pytest.approx(120.0 - 0.5, abs=0.05)
     assert outcome.sim_time > DEFAULT_SETTINGS.max_time
     # ...but no longer than the time to cross the table: a plan file may command 1e300 in
@@ -211,7 +211,7 @@ def test_overlapping_approach_is_reported():
     problem = make_problem(1)
     state = state_of(problem, b0=(3.0, 2.5, 0.0))
     outcome = simulate(problem, state, Push("paddle", (2.6, 2.5, EAST), 1.0))  # inside b0
-    assert outcome.status is StepStatus.OVERLAP
+    assert outcome.status is SimulationStatus.OVERLAP
 
 
 @pytest.mark.parametrize("theta", [EAST, NORTH])
@@ -221,7 +221,7 @@ def test_paddle_put_down_centred_on_a_block_is_reported(theta):
     problem = make_problem(1)
     state = state_of(problem, b0=(3.0, 2.5, 0.0))
     outcome = simulate(problem, state, Push("paddle", (3.0, 2.5, theta), 1.0))
-    assert outcome.status is StepStatus.OVERLAP
+    assert outcome.status is SimulationStatus.OVERLAP
     assert outcome.overlap == pytest.approx(2 * PADDLE_HALF)
     assert outcome.overlap > DEFAULT_SETTINGS.overlap_tolerance
 
@@ -321,7 +321,7 @@ def test_place_applies_noise_offset_and_pick_removes():
     picked = simulate(problem, placed.state, Pick("b1"))
     assert picked.ok and picked.state.names() == ("b0",)
     off = simulate(problem, state, Place("b0", (10.2, 3.0, 0.0)))
-    assert off.status is StepStatus.OFF_TABLE and off.off_table == ("b0",)
+    assert off.status is SimulationStatus.OFF_TABLE and off.off_table == ("b0",)
 
 
 @pytest.mark.parametrize(
@@ -458,9 +458,9 @@ def test_a_chattering_press_into_a_wall_ends_its_drive_once_stalled():
     theta, noise = rng.uniform(-0.09, 0.09), draw_noise(problem, push, rng)
     state = WorldState.from_mapping(problem, {"B": (6.0, 3.0, theta), "A": (2.0, 3.0, 0.0)})
     chattering = simulate(problem, state, push, noise, PhysicsSettings(stall_window=0.0))
-    assert chattering.status is StepStatus.NOT_AT_REST
+    assert chattering.status is SimulationStatus.NOT_AT_REST
     outcome = simulate(problem, state, push, noise)
-    assert outcome.status is StepStatus.OK
+    assert outcome.status is SimulationStatus.OK
     assert outcome.sim_time < 5.0
     x, y, th = outcome.state.pose("B")
     assert y == pytest.approx(0.5, abs=0.01)  # pressed against the wall
@@ -473,9 +473,10 @@ def test_a_controller_too_stiff_for_a_light_paddle_is_named_with_the_gain_that_i
     from arrange_up.physics.simulation import STABLE_RATE, stiff_manipulators
 
     tiny = catalogue.tiny("millimetre-paddle")
-    [(name, rate, kp_max)] = stiff_manipulators(tiny)
-    assert name == "tip" and rate > 2 * STABLE_RATE and 1.0 < kp_max < 300.0
-    at_limit = dataclasses.replace(tiny, controller=dataclasses.replace(tiny.controller, kp=kp_max))
+    [stiff] = stiff_manipulators(tiny)
+    assert stiff.name == "tip" and stiff.rate > 2 * STABLE_RATE and 1.0 < stiff.kp_max < 300.0
+    controller = dataclasses.replace(tiny.controller, kp=stiff.kp_max)
+    at_limit = dataclasses.replace(tiny, controller=controller)
     assert stiff_manipulators(at_limit) == []
     servo = dataclasses.replace(tiny, controller=SERVO_CONTROLLER)
     assert stiff_manipulators(servo) == []

@@ -27,7 +27,7 @@ from arrange_up.physics.settings import (
     SERVO_VALUES,
     PhysicsSettings,
 )
-from arrange_up.physics.simulation import StepStatus, simulate
+from arrange_up.physics.simulation import SimulationStatus, simulate
 
 EAST = -math.pi / 2  # paddle theta that pushes toward +x
 
@@ -89,7 +89,7 @@ def test_defaults_are_the_controllers_values_bit_for_bit(servo):
     default = _run(problem, DEFAULT_SETTINGS)
     explicit = _run(problem, dataclasses.replace(DEFAULT_SETTINGS, **values))
     assert default == explicit
-    assert default.status is StepStatus.OK
+    assert default.status is SimulationStatus.OK
 
 
 def test_sleeping_skips_idle_bodies_without_moving_them():
@@ -97,7 +97,7 @@ def test_sleeping_skips_idle_bodies_without_moving_them():
     awake = dataclasses.replace(DEFAULT_SETTINGS, **SERVO_VALUES)
     asleep = dataclasses.replace(awake, sleep_time=0.05)
     a, b = _run(problem, awake), _run(problem, asleep)
-    assert b.status is StepStatus.OK
+    assert b.status is SimulationStatus.OK
     assert b.state.pose("far") == a.state.pose("far") == (8.0, 0.6, 0.0)
     (xa, ya, ta), (xb, yb, tb) = a.state.pose("near"), b.state.pose("near")
     assert math.hypot(xa - xb, ya - yb) < 0.005 and abs(ta - tb) < 0.005
@@ -110,7 +110,7 @@ def test_compliant_defaults_take_fewer_steps_to_the_same_rest():
     problem = _problem(servo=False)
     old = _run(problem, dataclasses.replace(DEFAULT_SETTINGS, **SERVO_VALUES), 0.55)
     new = _run(problem, DEFAULT_SETTINGS, 0.55)
-    assert new.status is StepStatus.OK and old.status is StepStatus.OK
+    assert new.status is SimulationStatus.OK and old.status is SimulationStatus.OK
     assert new.steps < 0.8 * old.steps
     (xo, yo, to), (xn, yn, tn) = old.state.pose("near"), new.state.pose("near")
     assert math.hypot(xo - xn, yo - yn) < 0.01 and abs(to - tn) < 0.01

@@ -521,7 +521,7 @@ def test_up_plan_repairer(down_push):
 def test_statuses_are_string_enums_and_statistics_a_dataclass(down_push, down_repair):
     assert isinstance(down_repair.status, rp.RepairStatus)
     assert down_repair.status == "solved" and json.dumps(down_repair.status) == '"solved"'
-    assert down_repair.steps[0].status == rp.StepStatus.OK == "ok"
+    assert down_repair.steps[0].status == rp.StepRepairStatus.OK == "ok"
     assert all(isinstance(c.status, rp.CandidateStatus) for c in down_repair_scores(down_push))
     stats = down_repair.statistics
     assert isinstance(stats, rp.RepairStats)

@@ -10,7 +10,7 @@ import pytest
 
 from arrange_up.io.domains import load
 from arrange_up.model.world import Pick, Place, Push
-from arrange_up.physics.simulation import DEFAULT_SETTINGS, StepStatus
+from arrange_up.physics.simulation import DEFAULT_SETTINGS, SimulationStatus
 from arrange_up.planning.planner import plan
 from arrange_up.transitions import particles
 from arrange_up.transitions.particles import (
@@ -114,7 +114,7 @@ def test_a_refused_push_counts_its_reason(kind, blocks2, nominal, first_push, mo
     real = particles.simulate
 
     def capped(*args, **kwargs):  # every push hits the simulation's time cap
-        return dataclasses.replace(real(*args, **kwargs), status=StepStatus.NOT_AT_REST)
+        return dataclasses.replace(real(*args, **kwargs), status=SimulationStatus.NOT_AT_REST)
 
     monkeypatch.setattr(particles, "simulate", capped)
     assert semantics.apply(belief, first_push) is None
