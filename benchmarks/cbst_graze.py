@@ -86,7 +86,8 @@ from arrange_up.io.domains import load
 from arrange_up.model.problem import ArrangementProblem, Controller, ControllerKind, Uncertainty
 from arrange_up.model.world import Place, Push, WorldState, draw_noise
 from arrange_up.physics.simulation import simulate
-from arrange_up.planning import actions
+from arrange_up.planning.generators import places as place_generator
+from arrange_up.planning.generators.common import clean_pose
 from arrange_up.planning.planner import plan
 from arrange_up.transitions.cbst import GRAZE_ALLOWANCE, CBSTSemantics
 
@@ -184,18 +185,18 @@ def flush_within(spread: float | None) -> Iterator[None]:
 @contextlib.contextmanager
 def farther_places(enabled: bool) -> Iterator[None]:
     """The action generator's places, plus (where a part has none) places further out."""
-    original = actions.ActionGenerator.places
+    original = place_generator.PlaceGenerator.places
 
     def places(self, belief, only=None):
         found = original(self, belief, only)
         placed = {a.obj for a in found}
-        on_table = self._shadows(belief)
+        on_table = [(n, iv.center, iv.half) for n, iv in belief.objects]
         boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
         for spec in self.problem.parts:
             name = spec.name
             if name in belief or name in placed or (only is not None and name != only):
                 continue
-            for target in self._place_targets(name, belief):
+            for target in self.targets.place_targets(name, belief):
                 count = len(found)
                 for dx, dy in self.offsets[name]:
                     if (dx, dy) == (0.0, 0.0):
@@ -204,17 +205,17 @@ def farther_places(enabled: bool) -> Iterator[None]:
                         for theta in self._place_angles(target):
                             pose = (target[0] + k * dx, target[1] + k * dy, theta)
                             if self._place_ok(name, pose, self.place_unc, on_table, boxes):
-                                found.append(Place(name, actions._clean(pose)))
+                                found.append(Place(name, clean_pose(pose)))
                 if len(found) > count:
                     break
         return found
 
     if enabled:
-        actions.ActionGenerator.places = places
+        place_generator.PlaceGenerator.places = places
     try:
         yield
     finally:
-        actions.ActionGenerator.places = original
+        place_generator.PlaceGenerator.places = original
 
 
 def _problem(name: str, controller: str | None) -> ArrangementProblem:

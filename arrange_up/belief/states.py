@@ -283,15 +283,17 @@ def sample_initial_particles(
     rng: np.random.Generator,
     *,
     frame: AngleFrame | None = None,
+    checker: CollisionChecker | None = None,
     max_tries_per_particle: int = 1000,
 ) -> ParticleBelief:
     """Draw ``n`` initial world states uniformly from the initial intervals, rejecting samples
     in which objects overlap each other, an obstacle or a wall (thesis §3.1).
 
     Raises ``ValueError`` if a particle cannot be drawn in ``max_tries_per_particle`` tries
-    (an initial belief that is almost all collisions).
+    (an initial belief that is almost all collisions). ``frame`` and ``checker``: the
+    problem's, when the caller has them already.
     """
-    checker = CollisionChecker(problem)
+    checker = checker or CollisionChecker(problem)
     frame = frame or AngleFrame.of(problem)
     states = []
     for _ in range(n):

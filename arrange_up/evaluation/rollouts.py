@@ -40,7 +40,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from arrange_up.belief.goals import GoalTest
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.states import AngleFrame, sample_initial_particles
 from arrange_up.evaluation.outcomes import (
     ACTION_FAILED,
@@ -139,8 +139,9 @@ class Rollouts:
         self.push_settings = (
             settings if landing == "fail" else replace(settings, overlap_tolerance=math.inf)
         )
-        self.goal = GoalTest(problem)
-        self.frame = AngleFrame.of(problem)
+        compiled = compile_problem(problem)
+        self.goal = compiled.goal
+        self.frame = compiled.frame
         self.depths = PenetrationDepths(problem)
 
     def run(self, seed: int, index: int, trace: list[WorldState] | None = None) -> RolloutRecord:
@@ -263,14 +264,15 @@ def _draw_start(
     problem: ArrangementProblem, rng: np.random.Generator, frame: AngleFrame
 ) -> WorldState:
     """Step 1 of a rollout: its initial state, the first draws of its generator."""
-    return sample_initial_particles(problem, 1, rng, frame=frame).particles[0]
+    checker = compile_problem(problem).checker
+    return sample_initial_particles(problem, 1, rng, frame=frame, checker=checker).particles[0]
 
 
 def rollout_start(problem: ArrangementProblem, seed: int, index: int) -> WorldState:
     """The initial state rollout ``index`` of an evaluation with ``seed`` starts from (the state
     :func:`trace_rollout` begins with), drawn without running the rollout."""
     rng = np.random.default_rng([seed, index])
-    return _draw_start(problem, rng, AngleFrame.of(problem))
+    return _draw_start(problem, rng, compile_problem(problem).frame)
 
 
 def simulate_rollout(

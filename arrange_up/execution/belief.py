@@ -43,8 +43,8 @@ from typing import Any
 
 import numpy as np
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.states import (
-    AngleFrame,
     IntervalBelief,
     ObjectInterval,
     ParticleBelief,
@@ -152,7 +152,7 @@ class ParticleFilter:
         #: The noise scale the filter propagates with: 1 (the problem's model) until a model
         #: failure was recovered at a wider scale, with ``adapt``, then that scale.
         self.scale = 1.0
-        self.frame = AngleFrame.of(problem)
+        self.frame = compile_problem(problem).frame
         self._rollouts = {1.0: Rollouts(problem, (), landing=landing)}
 
     def initial(self) -> ParticleBelief:

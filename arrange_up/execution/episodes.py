@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from arrange_up.belief.states import AngleFrame
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.evaluation.outcomes import Failure, RolloutRecord
 from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.evaluation.reliability import FailureBreakdown, Reliability
@@ -52,7 +52,7 @@ EPISODES_FORMAT = "arrange-up-episodes/1"
 
 def sensor_for(problem: ArrangementProblem, sense: str) -> Sensor:
     """The sensor of ``sense`` for ``problem`` (its objects' symmetry periods)."""
-    return Sensor(sense, AngleFrame.of(problem).period)
+    return Sensor(sense, compile_problem(problem).frame.period)
 
 
 @dataclass(frozen=True)

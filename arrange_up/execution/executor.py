@@ -24,7 +24,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from arrange_up.belief.states import AngleFrame, sample_initial_particles
+from arrange_up.belief.compiled import compile_problem
+from arrange_up.belief.states import sample_initial_particles
 from arrange_up.evaluation.outcomes import Failure
 from arrange_up.evaluation.rollouts import Rollouts
 from arrange_up.execution.observations import Observation, Sensor
@@ -111,9 +112,9 @@ class SimulatedExecutor:
         self.rollouts = Rollouts(self.world, (), landing=landing)
         self.rng = np.random.default_rng([seed, episode])
         self.sense_rng = np.random.default_rng([seed, episode, 0x5E45E])
-        frame = AngleFrame.of(self.world)
+        world = compile_problem(self.world)
         self.state: WorldState = sample_initial_particles(
-            self.world, 1, self.rng, frame=frame
+            self.world, 1, self.rng, frame=world.frame, checker=world.checker
         ).particles[0]
         #: The true state before the first action, then after each (for storyboards).
         self.trace: list[WorldState] = [self.state]

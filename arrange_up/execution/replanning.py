@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from arrange_up.belief.goals import GoalTest
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.evaluation.outcomes import Failure
 from arrange_up.evaluation.rollouts import Rollouts
@@ -173,7 +173,7 @@ class ClosedLoop:
         self.sensor = sensor
         self.settings = settings
         self.seed = seed
-        self.goal = GoalTest(problem)
+        self.goal = compile_problem(problem).goal
         self._models: dict[float, ArrangementProblem] = {}
         self._filter: ParticleFilter | None = None  # the running episode's
 

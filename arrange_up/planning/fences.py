@@ -10,7 +10,7 @@ thing is. So along an axis of an absolute goal, a goal part *needs a fence* when
 * the free push's end spread, ``push[axis] + (stall_max - stall_min) / 2``, exceeds the goal
   tolerance along the axis;
 * the goal does not hold the part against a wall of the table along that axis (that wall
-  would do the job: :meth:`ActionGenerator._wall_trains`);
+  would do the job: :func:`~arrange_up.planning.generators.wall_trains.wall_trains`);
 * a fixture pressed against would do better than the tolerance: its own place spread,
   ``place[axis]`` plus the shift of its face over half the part's width for a place turned by
   ``place[theta]``, is below the tolerance; or a fixed obstacle already stands as a fence: its

@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalDominanceIndex
-from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Push
 from arrange_up.planning.actions import ActionGenerator
@@ -91,8 +91,8 @@ class BeliefTask:
             semantics, problem, particles=particles, seed=seed, workers=workers, model=model
         )
         try:
-            checker = CollisionChecker(problem)
-            goal = GoalTest(problem)
+            compiled = compile_problem(problem)
+            checker, goal = compiled.checker, compiled.goal
             generator = ActionGenerator(
                 problem,
                 checker,

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from arrange_up.belief.goals import GoalTest
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
@@ -83,7 +83,7 @@ class NominalReplay:
     def __init__(self, problem: ArrangementProblem) -> None:
         self.problem = problem
         self.model = DeterministicSemantics(problem)
-        self._goal = GoalTest(problem)
+        self._goal = compile_problem(problem).goal
 
     def initial(self) -> ParticleBelief:
         return self.model.initial_belief()

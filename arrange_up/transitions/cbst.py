@@ -65,7 +65,8 @@ from pathlib import Path
 
 import numpy as np
 
-from arrange_up.belief.states import AngleFrame, IntervalBelief, ObjectInterval, wrap_angle
+from arrange_up.belief.compiled import compile_problem
+from arrange_up.belief.states import IntervalBelief, ObjectInterval, wrap_angle
 from arrange_up.cbst.choice import model_for
 from arrange_up.cbst.contact_graph import (
     ROBOT,
@@ -80,7 +81,6 @@ from arrange_up.cbst.data import DEFAULT_GENERATION, GenerationSettings
 from arrange_up.cbst.features import BUCKLE_LIMIT, feature_row
 from arrange_up.cbst.frame import CanonicalFrame
 from arrange_up.cbst.store import DEFAULT_MODEL
-from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import (
     ArrangementProblem,
@@ -190,8 +190,9 @@ class CBSTSemantics:
         self._trained_overdrive = partial(
             wall_overdrive, settings.controller, settings.friction, settings.part_density
         )
-        self.angles = AngleFrame.of(problem)
-        self.checker = CollisionChecker(problem)
+        compiled = compile_problem(problem)
+        self.angles = compiled.frame
+        self.checker = compiled.checker
         self._order = {spec.name: i for i, spec in enumerate(problem.objects)}
         self._block = {spec.name: self._is_block(spec) for spec in problem.objects}
 

@@ -46,14 +46,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.states import (
-    AngleFrame,
     IntervalBelief,
     ParticleBelief,
     sample_initial_particles,
 )
 from arrange_up.geometry import shapes as geometry
-from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, Pose
 from arrange_up.model.world import (
@@ -169,8 +168,9 @@ class ParticleSemantics:
         self.simulations = 0
         #: Why transitions were refused (:meth:`Simulated.refusal`), one count per refusal.
         self.reasons: Counter[str] = Counter()
-        self.frame = AngleFrame.of(problem)
-        self.checker = CollisionChecker(problem)
+        compiled = compile_problem(problem)
+        self.frame = compiled.frame
+        self.checker = compiled.checker
         self._executor: Executor | None = None
         self._common: dict[int, list[tuple[ActionNoise, ActionNoise]]] = {}
 
@@ -204,7 +204,9 @@ class ParticleSemantics:
     # -- beliefs -----------------------------------------------------------------------------
     def initial_belief(self) -> ParticleBelief:
         rng = np.random.default_rng([self.seed, 0x1A1])
-        return sample_initial_particles(self.problem, self.particles, rng, frame=self.frame)
+        return sample_initial_particles(
+            self.problem, self.particles, rng, frame=self.frame, checker=self.checker
+        )
 
     def apply(self, belief: ParticleBelief, action: Action) -> ParticleBelief | None:
         if isinstance(action, Push):

@@ -12,7 +12,8 @@ from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.model.world import Pick, Place, Push
-from arrange_up.planning.actions import MIN_PUSH, ActionGenerator
+from arrange_up.planning.actions import ActionGenerator
+from arrange_up.planning.generators.common import MIN_PUSH
 from arrange_up.planning.obstacles import GAP
 
 NONE = (0.0, 0.0, 0.0)
@@ -97,7 +98,7 @@ def test_default_place_grid_steps_by_the_shadow_growth_plus_a_tenth():
     shadow = checker.shadow_box("A", NONE, problem.uncertainty.place)
     step = round(nominal[0] - shadow[0] + 0.1, 3)
     assert step == 0.412
-    grid = gen.offsets["A"]
+    grid = gen.place_generator.offsets["A"]
     assert len(grid) == 9 and set(grid) == {
         (i * step, j * step) for i in (-1, 0, 1) for j in (-1, 0, 1)
     }
@@ -110,7 +111,7 @@ def test_place_hints_replace_the_grid_and_add_angles():
     hints = "{place_offsets: [[-1, 1], [-2, 1], [0, 0]], place_angles: [0, 45]}"
     problem = with_planning("one-block", hints)
     gen = generator(problem)
-    assert gen.offsets["A"] == ((-1.0, 1.0), (-2.0, 1.0), (0.0, 0.0))
+    assert gen.place_generator.offsets["A"] == ((-1.0, 1.0), (-2.0, 1.0), (0.0, 0.0))
     quarter = math.radians(45)
     # The target's own angle once (the 0 offset repeats it), then 45 degrees from it; the
     # offset (0, 0) puts the shadow over the walls and is refused.
@@ -265,7 +266,7 @@ def test_relative_goals_have_no_wall_trains():
 def test_push_hints_restrict_directions_and_add_distances():
     problem = with_planning("one-block", '{push_directions: ["+x"], push_distances: [0.5, 0.501]}')
     gen = generator(servo(problem))
-    assert gen.directions == ("+x",)
+    assert gen.push_generator.directions == ("+x",)
     pushes = gen.pushes(belief(A=((2.5, 1.5, 0.0), SMALL)))
     assert {direction_of(p) for p in pushes} == {"+x"}
     gap = 2.0 - (pushes[0].pose[0] + PADDLE_HALF_THICKNESS)

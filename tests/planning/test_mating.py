@@ -83,14 +83,14 @@ def test_a_part_is_brought_beside_its_mate_with_clearance_and_seated_against_it(
     # Where each push would send the paddle's front, against the goal coordinate of B's rear
     # (A's right face, x = 3.5) and the compliant stall of B alone.
     fronts = [pose[0] - PADDLE_HALF_THICKNESS - p.distance for p in pushes]
-    stall = gen._stall("B", pair_belief(6.0), 0, -1)
+    stall = gen.stall.stall("B", pair_belief(6.0), 0, -1)
     u = problem.uncertainty
     over = wall_overdrive(problem.controller, u.friction, u.part_density, 1.0, u.push[0])
     assert fronts == pytest.approx([4.8 - stall, 4.5 - stall, 4.5 - over], abs=1e-3)
     assert over > stall
     # B spread wider than the tolerance relative to A (0.4 + 0.05 in): stopped short by that.
     wide = pair_belief(6.0, (0.4, 0.05, 0.03))
-    stall_wide = gen._stall("B", wide, 0, -1)
+    stall_wide = gen.stall.stall("B", wide, 0, -1)
     first = west_pushes(gen, wide)[0]
     front = first.pose[0] - PADDLE_HALF_THICKNESS - first.distance
     assert front == pytest.approx(4.5 + 0.45 - stall_wide, abs=1e-3)
@@ -135,7 +135,7 @@ def test_a_reference_wider_than_the_tolerance_is_gathered_to_an_edge():
     # The paddle's front ends where A's rear would be had its centre moved by its half-width
     # (every state swept to x = 3.4), plus the stall.
     front = push.pose[0] + PADDLE_HALF_THICKNESS + push.distance
-    assert front == pytest.approx(3.4 - 0.5 + gen._stall("A", wide, 0, 1), abs=1e-3)
+    assert front == pytest.approx(3.4 - 0.5 + gen.stall.stall("A", wide, 0, 1), abs=1e-3)
     # A within the tolerance (+-0.3 in): not gathered; B is not the reference.
     narrow = pair_belief(6.0)
     assert not any(math.isclose(p.pose[1], 3.0) for p in gen.pushes(narrow))

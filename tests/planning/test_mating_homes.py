@@ -71,9 +71,9 @@ def test_where_the_home_has_a_clear_place_the_reference_is_placed_only_about_it(
     assert not problem.obstacles
     generator = ActionGenerator(problem, CollisionChecker(problem))
     home = generator.mates.home
-    step = max(abs(dx) for dx, _ in generator.offsets["W"])
+    step = max(abs(dx) for dx, _ in generator.place_generator.offsets["W"])
     places = _w_places(generator, IntervalBelief(()))
-    assert len(places) == len(generator.offsets["W"])
+    assert len(places) == len(generator.place_generator.offsets["W"])
     assert all(_near(a.pose, home, step) for a in places)
     # A part standing on the home: the reference goes about the next home with a clear place.
     blocked = load_problem_text(

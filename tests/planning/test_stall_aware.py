@@ -146,7 +146,7 @@ def test_cbst_gets_the_stall_lengthened_distances_without_simulating_them(monkey
     unsolved = rightwards(solve_distances=False)
     assert not calls
     generator = ActionGenerator(compliant, CollisionChecker(compliant))
-    stall = generator.stall_per_area * 1.0  # A alone, 1 square inch
+    stall = generator.stall.per_area * 1.0  # A alone, 1 square inch
     (pose_x,) = {p.pose[0] for p in generator.pushes(belief) if p.pose[2] == -math.pi / 2}
     to_goal = (7.0 - 0.5) - (pose_x + 0.075) + (9.5 - 7.0) + stall
     assert any(abs(d - to_goal) < 1e-3 for d in unsolved)

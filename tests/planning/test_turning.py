@@ -14,7 +14,8 @@ from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.io.domains import load
 from arrange_up.io.yaml_problem import load_problem
 from arrange_up.model.world import Push
-from arrange_up.planning.actions import TURN_OFFSET, ActionGenerator
+from arrange_up.planning.actions import ActionGenerator
+from arrange_up.planning.generators.approach import TURN_OFFSET
 
 ELL_NOOK = Path(__file__).resolve().parents[1] / "problems" / "fresh" / "mm-ell-nook.yaml"
 
