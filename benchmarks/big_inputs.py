@@ -302,18 +302,24 @@ def run(args: list[str], timeout: float, limit_bytes: int) -> tuple[str, float, 
 
 
 def run_child(
-    args: list[str], timeout: float, limit_bytes: int, pythonpath: Path | None = None
+    args: list[str],
+    timeout: float,
+    limit_bytes: int,
+    pythonpath: Path | None = None,
+    entry: tuple[str, ...] = ("-m", "arrange_up"),
+    output: list[str] | None = None,
 ) -> tuple[str, float, float, float]:
     """Run ``python -m arrange_up ARGS`` in a child (the package of ``pythonpath`` when given,
-    else the one this process imports); ``(status, wall seconds, peak MB, CPU seconds)``, CPU
-    being the child's user + system time."""
+    else the one this process imports; ``entry`` replaces ``-m arrange_up``, e.g. by a ``-c``
+    program that runs the command); ``(status, wall seconds, peak MB, CPU seconds)``, CPU being
+    the child's user + system time. The child's output lines are added to ``output`` if given."""
     env = dict(os.environ)
     if pythonpath is not None:
         env["PYTHONPATH"] = str(pythonpath)
     with tempfile.TemporaryFile("w+") as out:
         t0 = time.perf_counter()
         proc = subprocess.Popen(
-            [sys.executable, "-m", "arrange_up", *args],
+            [sys.executable, *entry, *args],
             stdout=out,
             stderr=subprocess.STDOUT,
             text=True,
@@ -335,6 +341,8 @@ def run_child(
         proc.returncode = os.waitstatus_to_exitcode(code)  # already reaped above
         out.seek(0)
         tail = out.read().strip().splitlines()
+    if output is not None:
+        output += tail
     if seconds > timeout:
         status = f"stopped after {timeout:.0f} s"
     else:

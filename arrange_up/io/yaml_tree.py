@@ -30,6 +30,8 @@ found after such a tab in the text with those tabs made spaces (:func:`_untabbed
 Plain scalars are read by ruamel's YAML 1.2 rules unless ``%YAML 1.1`` says otherwise: ``yes``,
 ``on`` and ``1:30`` are strings, ``1e3`` is 1000.0, ``017`` is 17, ``.inf`` is infinite. A file
 means the same whichever parser reads it; ``tests/io/test_yaml_tree.py`` compares the two.
+Why the second reading is kept: docs/design/io.md, "the cost of ruamel alone"
+(``benchmarks/yaml_paths.py``).
 """
 
 from __future__ import annotations
