@@ -186,6 +186,7 @@ def plot(rows: list[dict], fits: dict, path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     figure, axes = plt.subplots(figsize=(7, 4.5), dpi=100)
     groups: dict[tuple[str, str], list[tuple[int, float]]] = {}
@@ -199,6 +200,9 @@ def plot(rows: list[dict], fits: dict, path: Path) -> None:
         fit = fits.get((family, semantics))
         label = f"{family}, {semantics}" + (f" (N^{fit[0]:.2f})" if fit else "")
         axes.loglog(*zip(*points, strict=True), marker="o", label=label)
+    sizes = sorted({n for points in groups.values() for n, _ in points})
+    axes.set_xticks(sizes, [str(n) for n in sizes])
+    axes.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     axes.set_xlabel("parts N")
     axes.set_ylabel("CPU seconds (plan, one worker)")
     axes.set_title("Planning time against the number of parts (generated problems)")
