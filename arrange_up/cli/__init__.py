@@ -3,7 +3,8 @@
 One module per command group (:mod:`~arrange_up.cli.problems`: domains, check, export;
 :mod:`~arrange_up.cli.show`; :mod:`~arrange_up.cli.plan`; :mod:`~arrange_up.cli.evaluate`;
 :mod:`~arrange_up.cli.execute`; :mod:`~arrange_up.cli.repair`; :mod:`~arrange_up.cli.train`;
-:mod:`~arrange_up.cli.experiments`; :mod:`~arrange_up.cli.bench`), and
+:mod:`~arrange_up.cli.experiments`; :mod:`~arrange_up.cli.bench`; :mod:`~arrange_up.cli.generate`),
+and
 :mod:`~arrange_up.cli.shared` for what they share. Each command parses its arguments, calls
 one library function, renders the result and sets the exit status (0 success, 1 a negative
 answer, 2 bad input; see :mod:`~arrange_up.cli.shared`).
@@ -62,6 +63,11 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
         "problems",
         "export",
         "Write PROBLEM as a PDDL 2.1 problem of the arrange-up domain (inches, degrees).",
+    ),
+    "generate": (
+        "generate",
+        "generate",
+        "Write a generated problem file of FAMILY with N parts (the scaling suite).",
     ),
     "plan": ("plan", "plan", "Search belief space for a conformant plan for PROBLEM."),
     "repair": (
