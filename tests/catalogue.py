@@ -81,6 +81,25 @@ goal:
   poses: {A: [5.5, 0.5, 0]}
 uncertainty: {place: [0.2, 0.2, 15], push: [0.05, 0.05, 3]}
 """,
+    # Two cubes lying on a walled 16 x 10 in board, to be put in a row one inch above the bottom
+    # wall (the second row of a pack whose first row is not asked for), F left of G; F lies
+    # right of G at the start, so the ordering filter calls the start a dead end although
+    # either cube can be pushed out of the other's row.
+    "second-row-pair": """
+name: second-row-pair
+table: {size: [16, 10]}
+objects:
+  F: {kind: part, shape: {box: [1, 1]}}
+  G: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+initial:
+  F: {pose: [11, 3.5, 0], uncertainty: [0.2, 0.2, 10]}
+  G: {pose: [7, 4, 0], uncertainty: [0.2, 0.2, 10]}
+goal:
+  tolerance: [0.2, 0.2, 15]
+  poses: {F: [0.5, 1.5, 0], G: [1.5, 1.5, 0]}
+uncertainty: {place: [0.2, 0.2, 15], push: [0.05, 0.05, 3]}
+""",
     # A non-convex L-shaped part (two convex pieces after decomposition), starting on the table.
     "l-part": """
 name: l-part

@@ -71,6 +71,7 @@ def _plan_case(
             particles=particles,
             seed=seed,
             validate=validate,
+            agenda=False,  # the goldens pin the whole goal's search
         )
         data = {
             "status": plain(result.status),
@@ -92,7 +93,12 @@ def _evaluation_case(
     def case() -> Any:
         problem = _load(name, servo)
         result = arrange_up.plan(
-            problem, semantics=semantics, particles=particles, seed=seed, validate=validate
+            problem,
+            semantics=semantics,
+            particles=particles,
+            seed=seed,
+            validate=validate,
+            agenda=False,  # the goldens pin the whole goal's search
         )
         reliability = evaluate_plan(problem, result.actions, rollouts=200, seed=0, workers=1)
         data = plain(reliability.to_json())
@@ -106,7 +112,7 @@ def _evaluation_case(
 def _repair_case(name: str, particles: int, servo: bool) -> Callable[[], Any]:
     def case() -> Any:
         problem = _load(name, servo)
-        nominal = arrange_up.plan(problem, semantics="deterministic")
+        nominal = arrange_up.plan(problem, semantics="deterministic", agenda=False)
         result = repair_plan(problem, nominal.actions, particles=particles, seed=0, workers=1)
         return {
             "status": plain(result.status),

@@ -41,10 +41,15 @@ def _status_line(stats: dict[str, Any]) -> str:
     """The live search status shown on a terminal."""
     best = stats.get("best_h")
     again = f"search {stats['search']} (validation failed): " if "search" in stats else ""
-    return again + (
-        f"expanded {stats['expanded']:>6}  generated {stats['generated']:>7}  "
-        f"simulated {stats['transitions_simulated']:>8}  best h "
-        f"{'-' if best is None else f'{best:g}'}  {stats['elapsed']:6.1f} s"
+    stage = f"{stats['stage']}: " if "stage" in stats else ""
+    return (
+        again
+        + stage
+        + (
+            f"expanded {stats['expanded']:>6}  generated {stats['generated']:>7}  "
+            f"simulated {stats['transitions_simulated']:>8}  best h "
+            f"{'-' if best is None else f'{best:g}'}  {stats['elapsed']:6.1f} s"
+        )
     )
 
 
@@ -109,6 +114,13 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 )
 @click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
 @click.option(
+    "--agenda/--no-agenda",
+    default=library_default(run_plan, "agenda"),
+    show_default=True,
+    help="Search one part at a time, in an order taken from the goal's geometry (the goal "
+    "agenda), before the whole goal; --no-agenda searches the whole goal only.",
+)
+@click.option(
     "--validate",
     type=click.IntRange(0, None),
     default=None,
@@ -144,6 +156,7 @@ def plan(
     heuristic: str,
     weight: float,
     no_dominance: bool,
+    agenda: bool,
     validate: int | None,
     workers: int | None,
     backend: str | None,
@@ -216,6 +229,7 @@ def plan(
                 heuristic=heuristic,
                 weight=weight,
                 dominance=not no_dominance,
+                agenda=agenda,
                 workers=workers,
                 backend=backend,
                 scheduler=scheduler,
@@ -253,6 +267,8 @@ def plan(
             f"generated {stats['generated']}, "
             f"transitions simulated {stats['transitions_simulated']}"
         )
+        if result.agenda is not None:
+            click.echo(result.agenda.line())
         if result.reason is not None:
             click.echo(result.reason)
         if result.validation is not None:

@@ -151,6 +151,7 @@ def transition_comparison(
                         max_nodes=max_nodes,
                         timeout=timeout,
                         workers=workers,
+                        agenda=False,  # the thesis's search, whose figures these reproduce
                     )
                     seconds = time.perf_counter() - start
                     row: dict[str, Any] = {
@@ -274,6 +275,7 @@ def search_table(
                         weight=weight,
                         timeout=timeout,
                         workers=workers or 1,
+                        agenda=False,  # the configurations compared search the whole goal
                     )
                     row = {
                         "search": label,

@@ -62,15 +62,20 @@ def make_heuristic(
     goal: GoalTest,
     checker: CollisionChecker,
     generator: ActionGenerator | None = None,
+    ordering_filter: bool = True,
 ) -> Heuristic:
     """Build the named heuristic for one problem (see the module docstring).
 
     ``generator`` (the planner's action generator) lets the ordering filter recognise goal
     parts that can no longer be placed; without it that part of the filter is off.
+    ``ordering_filter=False`` leaves the filter out of every heuristic (none is ever infinite):
+    the filter is itself a heuristic, and where it leaves nothing to search the planner searches
+    again without it.
     """
     if name not in HEURISTICS:
         raise ValueError(f"unknown heuristic {name!r}; expected one of {', '.join(HEURISTICS)}")
     ordering = _OrderingFilter(problem, goal, checker, generator)
+    violated = ordering.violated if ordering_filter else _never
 
     def blind(_: ParticleBelief) -> float:
         return 0.0
@@ -86,7 +91,7 @@ def make_heuristic(
         return total
 
     def admissible(belief: ParticleBelief) -> float:
-        if ordering.violated(belief):
+        if violated(belief):
             return math.inf
         names = belief.names()
         return float(sum(1 for p in goal.parts if p not in names) + _left(goal, names))
@@ -97,17 +102,22 @@ def make_heuristic(
     span = (len(goal.parts) + 1) * (problem.table.width + problem.table.depth) + 1.0
 
     def inadmissible(belief: ParticleBelief) -> float:
-        if ordering.violated(belief):
+        if violated(belief):
             return math.inf
         return per_dimension_count(goal, belief) + min(manhattan(belief) / span, 0.999)
 
     return {
         "blind": blind,
         "manhattan": manhattan,
-        "ordering": lambda b: math.inf if ordering.violated(b) else 0.0,
+        "ordering": lambda b: math.inf if violated(b) else 0.0,
         "admissible": admissible,
         "inadmissible": inadmissible,
     }[name]
+
+
+def _never(_: ParticleBelief) -> bool:
+    """The ordering filter left out: no belief violates it."""
+    return False
 
 
 def per_dimension_count(goal: GoalTest, belief: ParticleBelief) -> float:

@@ -12,10 +12,11 @@ import dataclasses
 import functools
 import math
 import time
-from collections.abc import Callable
+from collections import Counter
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 from arrange_up.belief.goals import PartMiss
 from arrange_up.belief.states import ParticleBelief
@@ -23,6 +24,7 @@ from arrange_up.io.planfile import plan_document
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
 from arrange_up.parallel import Runner, SerialRunner, check_runner_options, get_runner
+from arrange_up.planning.agenda import AgendaRecord, plan_by_agenda
 from arrange_up.planning.fitting import too_large, unfit_parts
 from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
@@ -96,6 +98,18 @@ class SearchSnapshot:
         """The statistics as a JSON object, keys in field order (as plan files store them)."""
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
+    def plus(self, earlier: SearchSnapshot) -> Self:
+        """These statistics with the counters and seconds of ``earlier`` (a search of the same
+        run before this one) added, and the smaller ``best_h``; the rest (a
+        :class:`PlanStatistics`' configuration) is this one's."""
+        counted = {
+            f.name: getattr(self, f.name) + getattr(earlier, f.name)
+            for f in fields(SearchSnapshot)
+            if f.name != "best_h"
+        }
+        seen = [h for h in (self.best_h, earlier.best_h) if h is not None]
+        return dataclasses.replace(self, **counted, best_h=min(seen) if seen else None)
+
 
 @dataclass(frozen=True)
 class PlanStatistics(SearchSnapshot):
@@ -130,6 +144,8 @@ class PlanResult:
     search's start but no place candidate there, every one failing the place precondition
     (their shadow must keep clear of walls, obstacles and the parts on the table: a part that
     fits its goal only touching them is never placed).
+    ``agenda`` (None when the run searched the whole goal only): what the goal agenda did and
+    which search found the plan (:class:`~arrange_up.planning.agenda.AgendaRecord`).
     ``validation`` (None when the plan was not validated): how the plan, and each search, did
     on fresh rollouts (the ``validate`` argument of :func:`plan`). Of a validated run,
     ``statistics`` are those of the search whose plan is returned, but ``elapsed`` is the
@@ -149,10 +165,25 @@ class PlanResult:
     validation: Validation | None = None
     unplaceable: tuple[str, ...] = ()
     unfit: tuple[str, ...] = ()
+    agenda: AgendaRecord | None = None
 
     @property
     def solved(self) -> bool:
         return self.status == SearchStatus.SOLVED
+
+    def after(self, earlier: Sequence[PlanResult], max_nodes: int) -> PlanResult:
+        """This result, of the last search of a run of several, with the statistics and the
+        refusals of the ``earlier`` searches added, and the run's node limit ``max_nodes``."""
+        statistics = self.statistics
+        refusals = Counter(dict(self.refusals))
+        for result in earlier:
+            statistics = statistics.plus(result.statistics)
+            refusals.update(dict(result.refusals))
+        return dataclasses.replace(
+            self,
+            statistics=dataclasses.replace(statistics, max_nodes=max_nodes),
+            refusals=tuple(refusals.most_common()),
+        )
 
     @property
     def reason(self) -> str | None:
@@ -207,6 +238,7 @@ class PlanResult:
             extra={
                 "particles": self.particles,
                 **({"model": model} if model else {}),
+                **({"agenda": self.agenda.to_json()} if self.agenda else {}),
                 **({"validation": self.validation.to_json()} if self.validation else {}),
             },
         )
@@ -258,6 +290,7 @@ def plan(
     model: str | Path | None = None,
     start: Any = None,
     validate: int | None = None,
+    agenda: bool = True,
 ) -> PlanResult:
     """Search for a conformant plan for ``problem``.
 
@@ -342,6 +375,13 @@ def plan(
         semantics and 60 for ``cbst`` (conformant plans), 0 (off) for ``deterministic`` (nominal
         plans); 0 turns it off. A ``start`` belief (a posterior, not the problem's initial
         uncertainty) takes no validation: a positive value with one raises ``ValueError``.
+    agenda
+        Search by the goal agenda first (:mod:`arrange_up.planning.agenda`): one part at a
+        time in an order taken from the goal's geometry, each from the belief the previous
+        part's plan reached; where it fails, the whole goal is searched (with the whole node
+        limit, in the time left). :attr:`PlanResult.agenda` says which found the plan. False:
+        the whole goal only. Each search, of a subgoal or of the whole goal, runs again
+        without the ordering filter where the filter left nothing to search.
     """
     check_validate(validate, start)
     if validate is None:
@@ -361,27 +401,42 @@ def plan(
         report = progress
         if progress is not None and number > 1:
             report = functools.partial(_numbered, progress, number)
-        return _search(
-            problem,
-            semantics=semantics,
-            particles=particles,
-            seed=seed,
-            max_nodes=max_nodes,
-            timeout=left,
-            heuristic=heuristic,
-            dominance=dominance,
-            weight=weight,
-            deferred=deferred,
-            workers=workers,
-            backend=backend,
-            scheduler=scheduler,
-            tie_break=tie_break,
-            variety=variety,
-            progress=report,
-            should_stop=should_stop,
-            model=model,
-            start=start,
-        )
+
+        def one(
+            goal: ArrangementProblem,
+            start: Any,
+            nodes: int,
+            seconds: float | None,
+            tell: ProgressCallback | None,
+        ) -> PlanResult:
+            return _searched(
+                goal,
+                semantics=semantics,
+                particles=particles,
+                seed=seed,
+                max_nodes=nodes,
+                timeout=seconds,
+                heuristic=heuristic,
+                dominance=dominance,
+                weight=weight,
+                deferred=deferred,
+                workers=workers,
+                backend=backend,
+                scheduler=scheduler,
+                tie_break=tie_break,
+                variety=variety,
+                progress=tell,
+                should_stop=should_stop,
+                model=model,
+                start=start,
+            )
+
+        limit = _node_limit(problem, max_nodes)
+        if agenda:
+            return plan_by_agenda(
+                problem, one, start=start, max_nodes=limit, timeout=left, progress=report
+            )
+        return one(problem, start, limit, left, report)
 
     stopped_by: list[str] = []  # what ended the validation early, once it has
 
@@ -449,6 +504,32 @@ def _numbered(progress: ProgressCallback, number: int, stats: dict[str, Any]) ->
     progress({**stats, "search": number})
 
 
+def _node_limit(problem: ArrangementProblem, max_nodes: int | None) -> int:
+    """The node limit of a run: ``max_nodes``, else the problem's, else the default."""
+    return max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)
+
+
+def _searched(
+    problem: ArrangementProblem, *, max_nodes: int, timeout: float | None, **options: Any
+) -> PlanResult:
+    """:func:`_search`, and where the ordering filter left nothing to search (the search ran
+    out of beliefs having cut some as dead ends, the start perhaps), the search again without
+    the filter in the nodes and time left: the filter is a heuristic, and ``exhausted`` must
+    mean that the space was searched. The statistics count both searches."""
+    started = time.monotonic()
+    first = _search(problem, max_nodes=max_nodes, timeout=timeout, **options)
+    if first.status != SearchStatus.EXHAUSTED or not first.statistics.pruned_infinite:
+        return first
+    again = _search(
+        problem,
+        max_nodes=max_nodes - first.statistics.expanded,
+        timeout=None if timeout is None else max(0.0, timeout - (time.monotonic() - started)),
+        ordering_filter=False,
+        **options,
+    )
+    return again.after([first], max_nodes)
+
+
 def _search(
     problem: ArrangementProblem,
     *,
@@ -470,12 +551,12 @@ def _search(
     should_stop: Callable[[], bool] | None,
     model: str | Path | None,
     start: Any,
+    ordering_filter: bool = True,
 ) -> PlanResult:
-    """One best-first search of :func:`plan` (its arguments of the same names), unvalidated."""
+    """One best-first search of :func:`plan` (its arguments of the same names), unvalidated;
+    ``ordering_filter=False`` leaves the ordering filter out of the heuristic."""
     started = time.monotonic()
-    limit = (
-        max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)
-    )
+    limit = _node_limit(problem, max_nodes)
     # bad backend options fail before the task is built, whether a runner is made or not
     check_runner_options(backend, workers, scheduler)
     task = BeliefTask.build(
@@ -489,6 +570,7 @@ def _search(
         variety=variety,
         model=model,
         start=start,
+        ordering_filter=ordering_filter,
     )
     # A learned prediction (CBST) costs less than shipping its job to a worker and back:
     # workers only slowed such a search down, so it runs in this process (same plan), and no
@@ -501,7 +583,7 @@ def _search(
             task.close()
             raise
     index = task.dominance_index()
-    spec = WorkerSpec(problem, semantics, particles, seed, heuristic, model)
+    spec = WorkerSpec(problem, semantics, particles, seed, heuristic, model, ordering_filter)
     evaluator = SuccessorEvaluator(task, runner, spec, index)
 
     def report(stats: SearchStats) -> None:

@@ -98,6 +98,7 @@ class WorkerSpec:
     seed: int
     heuristic: str
     model: str | Path | None = None
+    ordering_filter: bool = True
     _task: BeliefTask | None = field(default=None, repr=False)
     _lock: Any = field(default=None, repr=False)
 
@@ -122,6 +123,7 @@ class WorkerSpec:
                 dominance=False,
                 variety=False,
                 model=self.model,
+                ordering_filter=self.ordering_filter,
             )
         return self._task
 

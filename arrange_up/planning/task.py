@@ -81,8 +81,11 @@ class BeliefTask:
         variety: bool,
         model: str | Path | None = None,
         start: Any = None,
+        ordering_filter: bool = True,
     ) -> BeliefTask:
-        """The task of :func:`~arrange_up.planning.planner.plan`'s arguments of the same names.
+        """The task of :func:`~arrange_up.planning.planner.plan`'s arguments of the same names;
+        ``ordering_filter=False`` leaves the ordering filter out of the heuristic
+        (:func:`~arrange_up.planning.heuristics.make_heuristic`).
 
         The semantics is instantiated first (it may start worker processes); it is closed
         again if building the rest fails.
@@ -102,7 +105,9 @@ class BeliefTask:
                 solve_distances=model.simulates_pushes,
                 clearance_pushes=model.particles > 1,
             )
-            estimate = make_heuristic(heuristic, problem, goal, checker, generator)
+            estimate = make_heuristic(
+                heuristic, problem, goal, checker, generator, ordering_filter=ordering_filter
+            )
         except BaseException:
             model.close()
             raise

@@ -58,6 +58,7 @@ def nominal_plans(
             tie_break=True,
             variety=j > 0,
             max_nodes=max_nodes,
+            agenda=False,  # the thesis's nominal plans (ch. 4): the whole goal's search
         )
         if result.actions is None or result.actions in seen:
             continue

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
-from catalogue import servo, tiny
+from catalogue import particle_task, servo, tiny
 
 from arrange_up.belief.goals import GoalTest
 from arrange_up.io.domains import load
@@ -87,7 +88,8 @@ def test_worker_processes_do_not_change_the_result(blocks2):
 
 
 def test_node_limit_and_timeout_are_reported_honestly(blocks2):
-    limited = plan(blocks2, semantics="deterministic", max_nodes=1)
+    # the whole goal's search alone: the agenda's searches would add their nodes
+    limited = plan(blocks2, semantics="deterministic", max_nodes=1, agenda=False)
     assert limited.status == SearchStatus.NODE_LIMIT and limited.actions is None
     assert limited.stats["expanded"] == 1
     timed = plan(blocks2, semantics="deterministic", timeout=1e-9)
@@ -96,7 +98,7 @@ def test_node_limit_and_timeout_are_reported_honestly(blocks2):
 
 def test_status_and_statistics_are_typed_and_serialise_as_before(blocks2):
     snapshots = []
-    result = plan(blocks2, semantics="deterministic", progress=snapshots.append)
+    result = plan(blocks2, semantics="deterministic", progress=snapshots.append, agenda=False)
     assert result.status is SearchStatus.SOLVED and result.status == "solved"
     assert json.dumps(result.status) == '"solved"'
     assert isinstance(result.statistics, PlanStatistics)
@@ -227,10 +229,12 @@ goal:
 
 def test_parts_that_fit_only_touching_the_walls_are_named_as_never_placed():
     # Two blocks that fill the walled table exactly: no place keeps its shadow clear of the
-    # walls (touching counts as a collision), so the ordering filter prunes the start belief.
+    # walls (touching counts as a collision), so the ordering filter prunes the start belief;
+    # searched again without the filter, the start has no candidate: exhausted after it.
     problem, _ = check_problem_text(EXACT_FIT, "exact-fit")
-    result = plan(problem, semantics="deterministic", workers=1)
-    assert result.status is SearchStatus.EXHAUSTED and result.stats["expanded"] == 0
+    result = plan(problem, semantics="deterministic", workers=1, agenda=False)
+    assert result.status is SearchStatus.EXHAUSTED and result.stats["expanded"] == 1
+    assert result.stats["pruned_infinite"] == 1
     assert result.unplaceable == ("A", "B")
     assert result.reason.endswith(
         "the best belief still misses A (not on the table), B (not on the table); no place of "
@@ -332,9 +336,22 @@ def test_a_solved_run_has_no_reason():
 
 
 def test_a_node_limit_says_which_parts_the_best_belief_has_not_placed(blocks2):
-    result = plan(blocks2, semantics="deterministic", max_nodes=1)
+    result = plan(blocks2, semantics="deterministic", max_nodes=1, agenda=False)
     assert result.status is SearchStatus.NODE_LIMIT
     assert result.reason.startswith("node-limit after 1 node: ")
     assert result.reason.endswith(
         "the best belief still misses A (not on the table), B (not on the table)"
     )
+
+
+def test_where_the_ordering_filter_cuts_the_start_the_search_goes_on_without_it():
+    # Issue 32 (c): F lies right of G in the row the goal puts F left of G, so the filter
+    # calls the start a dead end; yet either cube can be pushed out of the other's row.
+    problem = tiny("second-row-pair")
+    with particle_task(problem, 5) as task:
+        assert task.heuristic(task.initial_belief()) == math.inf
+    for semantics in ("deterministic", "particles"):
+        result = plan(problem, semantics=semantics, particles=5, workers=1, agenda=False)
+        assert result.solved, result.reason
+        # the filtered search cut the start; the statistics count it and the second search
+        assert result.statistics.pruned_infinite >= 1 and result.stats["expanded"] > 0

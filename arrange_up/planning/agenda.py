@@ -1,0 +1,361 @@
+"""The goal agenda: a plan built one part (or a small group of parts) at a time.
+
+A best-first search over the whole goal pays for the parts' interleavings: its cost grows
+exponentially with the length of a row, because every belief with the same count of parts in
+tolerance looks alike to the heuristic. A part whose goal is pressed against walls and parts
+already finished, though, is one short search away: placed beside them and pushed against
+them, its pose is certain. The agenda therefore
+
+1. **orders the parts from the goal's geometry** (:func:`goal_order`): greedily, the next part
+   is the one whose goal touches the most directions of support (walls, obstacles and fixtures
+   standing on the table, and the parts already ordered), ties broken by more contacts, then by
+   the distance of its goal from the anchor (the corner of two walls nearest the goal, else the
+   nearest point of a support, else the goal's centre), then by the goal's own order. A part
+   goes in after what it is pressed against, and a row is built from its wall outwards;
+2. **searches one subgoal at a time** (:func:`plan_by_agenda`): subgoal k is the goal
+   restricted to the first k parts of the order (the finished parts are held to their goal by
+   the goal test; the parts still to come need not be on the table), searched from the belief
+   the previous subgoal's plan reached, with a node budget of :func:`subgoal_budget` per part;
+3. **backtracks** when a subgoal fails (no plan within its budget, or none at all): the part
+   is searched together with the next one (a group of two), else the previous subgoal is
+   searched again together with it, from the belief before it; groups stay within
+   :data:`MAX_GROUP` parts. The plan is the concatenation of the subgoals' plans.
+
+Nothing solvable by the full search is lost: where the agenda fails (a subgoal fails whatever
+the grouping, or the agenda has spent the run's node limit), the full search runs with the
+whole node limit in the time left. :class:`AgendaRecord` says which of them found the plan.
+The agenda applies to absolute goals of two or more parts; a relative goal (its parts hold
+their goal only with respect to a reference that may end anywhere) is searched whole.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from shapely.geometry import Point, box
+from shapely.geometry.base import BaseGeometry
+
+from arrange_up.geometry.boxes import wall_boxes
+from arrange_up.geometry.shapes import footprint
+from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind
+from arrange_up.search import SearchStatus
+
+if TYPE_CHECKING:
+    from arrange_up.planning.planner import PlanResult, ProgressCallback
+
+__all__ = [
+    "CONTACT_GAP",
+    "MAX_GROUP",
+    "MIN_SUBGOAL_NODES",
+    "AgendaRecord",
+    "SubSearch",
+    "goal_order",
+    "plan_by_agenda",
+    "restricted",
+    "subgoal_budget",
+]
+
+#: Goal footprints closer than this (in) touch: goals are written flush, up to rounding.
+CONTACT_GAP = 0.05
+#: A contact shorter than this (in) is a corner meeting, which presses nothing.
+MIN_CONTACT = 0.2
+#: The most parts one subgoal adds (a part, merged with its successor or its predecessor).
+MAX_GROUP = 3
+#: The fewest nodes a subgoal's search may expand per part it adds.
+MIN_SUBGOAL_NODES = 50
+
+#: The statuses that end the agenda and skip the full search: no time is left, the caller
+#: asked to stop, or the problem is proven unsolvable.
+_FINAL = frozenset({SearchStatus.TIMEOUT, SearchStatus.CANCELLED, SearchStatus.UNSOLVABLE})
+
+#: One search of the planner: ``(problem, start, max_nodes, timeout, progress)`` to a
+#: :class:`~arrange_up.planning.planner.PlanResult`; ``start`` None is the problem's initial
+#: belief, ``timeout`` None no time limit.
+SubSearch = Callable[
+    [ArrangementProblem, Any, int, "float | None", "ProgressCallback | None"], "PlanResult"
+]
+
+
+@dataclass(frozen=True)
+class AgendaRecord:
+    """What the agenda did in one planning run.
+
+    ``order``: the parts in the agenda's order; ``subgoals``: the parts each subgoal added, in
+    the plan's order, when the agenda found the plan (else those it had finished when it
+    failed); ``solved_by``: ``"agenda"`` or ``"full search"``, None when neither found a plan;
+    ``expanded``: the nodes the agenda's searches expanded (the full search's come on top);
+    ``failed_at``: the parts the agenda was adding when it gave up (None if it did not).
+    """
+
+    order: tuple[str, ...]
+    subgoals: tuple[tuple[str, ...], ...]
+    solved_by: str | None
+    expanded: int
+    failed_at: tuple[str, ...] | None = None
+
+    def line(self) -> str:
+        """One line for the command line: which search found the plan, or where the agenda
+        stopped."""
+        n = len(self.subgoals)
+        if self.solved_by == "agenda":
+            return (
+                f"solved by the agenda ({n} subgoal{'s' if n != 1 else ''}: "
+                f"{' '.join('+'.join(group) for group in self.subgoals)})"
+            )
+        done = sum(len(group) for group in self.subgoals)
+        where = (
+            f"the agenda failed at part {done + 1} of {len(self.order)} "
+            f"({'+'.join(self.failed_at)}) after {self.expanded} nodes"
+            if self.failed_at
+            else f"the agenda stopped at part {done + 1} of {len(self.order)}"
+        )
+        if self.solved_by == "full search":
+            return f"solved by the full search ({where})"
+        return where
+
+    def to_json(self) -> dict[str, Any]:
+        """The record as plan files store it (``agenda``)."""
+        return {
+            "order": list(self.order),
+            "subgoals": [list(group) for group in self.subgoals],
+            "solved_by": self.solved_by,
+            "expanded": self.expanded,
+            "failed_at": None if self.failed_at is None else list(self.failed_at),
+        }
+
+
+def subgoal_budget(max_nodes: int, parts: int) -> int:
+    """The nodes a subgoal's search may expand per part it adds: an equal share of the run's
+    node limit, at least :data:`MIN_SUBGOAL_NODES`."""
+    return max(MIN_SUBGOAL_NODES, max_nodes // max(parts, 1))
+
+
+def restricted(problem: ArrangementProblem, parts: tuple[str, ...]) -> ArrangementProblem:
+    """``problem`` with its goal restricted to ``parts`` (same tolerance, absolute targets)."""
+    keep = set(parts)
+    goal = problem.goal
+    targets = tuple((name, pose) for name, pose in goal.targets if name in keep)
+    return dataclasses.replace(problem, goal=Goal(targets, goal.tolerance, goal.reference))
+
+
+# -- the order -------------------------------------------------------------------------------
+def goal_order(problem: ArrangementProblem) -> tuple[str, ...] | None:
+    """The goal parts in the agenda's order (module docstring), or None where the agenda does
+    not apply (a relative goal, or fewer than two parts)."""
+    goal = problem.goal
+    if goal.is_relative or len(goal.parts) < 2:
+        return None
+    shapes = {
+        name: footprint(problem.object(name).shape.parts, goal.target(name)) for name in goal.parts
+    }
+    supports = _fixed_supports(problem)
+    anchor = _anchor(problem, supports, shapes)
+    distance = {name: shapes[name].centroid.distance(anchor) for name in goal.parts}
+    rank = {name: k for k, name in enumerate(goal.parts)}
+    fixed = {name: _sides(shape, supports) for name, shape in shapes.items()}
+    order: list[str] = []
+    left = list(goal.parts)
+
+    def key(name: str) -> tuple[int, int, float, int]:
+        sides = fixed[name] + _sides(shapes[name], [shapes[done] for done in order])
+        return (-len(set(sides)), -len(sides), distance[name], rank[name])
+
+    while left:
+        best = min(left, key=key)
+        order.append(best)
+        left.remove(best)
+    return tuple(order)
+
+
+def _sides(shape: BaseGeometry, others: list[BaseGeometry]) -> list[int]:
+    """The sides on which ``others`` press ``shape`` (:func:`_direction`), one per contact."""
+    sides = (_direction(shape, other) for other in others)
+    return [side for side in sides if side is not None]
+
+
+def _fixed_supports(problem: ArrangementProblem) -> list[BaseGeometry]:
+    """What a part can be pressed against before any part is placed: the walls, and the
+    obstacles and fixtures standing on the table at the start (at their initial poses)."""
+    supports: list[BaseGeometry] = [
+        box(*bounds) for bounds in wall_boxes(problem.table.size, problem.table.walls).values()
+    ]
+    for spec in problem.objects:
+        if spec.kind in (ObjectKind.OBSTACLE, ObjectKind.FIXTURE):
+            initial = problem.initial_of(spec.name)
+            if initial is not None:
+                supports.append(footprint(spec.shape.parts, initial.pose))
+    return supports
+
+
+def _anchor(
+    problem: ArrangementProblem, supports: list[BaseGeometry], shapes: dict[str, BaseGeometry]
+) -> Point:
+    """Where the agenda starts building: the corner of two walls nearest the goal's centre,
+    else the nearest point of a support, else the goal's centre."""
+    xs = [shape.centroid.x for shape in shapes.values()]
+    ys = [shape.centroid.y for shape in shapes.values()]
+    centre = Point(sum(xs) / len(xs), sum(ys) / len(ys))
+    width, depth = problem.table.size
+    walls = set(problem.table.walls)
+    corners = [
+        Point(x, y)
+        for (side, x) in (("left", 0.0), ("right", width))
+        for (end, y) in (("bottom", 0.0), ("top", depth))
+        if side in walls and end in walls
+    ]
+    if corners:
+        return min(corners, key=centre.distance)
+    if supports:
+        nearest = min(supports, key=centre.distance)
+        return nearest.exterior.interpolate(nearest.exterior.project(centre))
+    return centre
+
+
+def _direction(shape: BaseGeometry, other: BaseGeometry) -> int | None:
+    """The side (0: +x, 1: +y, 2: -x, 3: -y) on which ``other`` presses ``shape``, or None
+    when they do not touch along a face (farther apart than :data:`CONTACT_GAP`, or meeting
+    at a corner only)."""
+    if shape.distance(other) > CONTACT_GAP:
+        return None
+    region = shape.buffer(CONTACT_GAP).intersection(other.buffer(CONTACT_GAP))
+    x0, y0, x1, y1 = region.bounds
+    if max(x1 - x0, y1 - y0) < MIN_CONTACT + 2 * CONTACT_GAP:
+        return None
+    dx = region.centroid.x - shape.centroid.x
+    dy = region.centroid.y - shape.centroid.y
+    return round(math.atan2(dy, dx) / (0.5 * math.pi)) % 4
+
+
+# -- the search ------------------------------------------------------------------------------
+def plan_by_agenda(
+    problem: ArrangementProblem,
+    search: SubSearch,
+    *,
+    start: Any,
+    max_nodes: int,
+    timeout: float | None,
+    progress: ProgressCallback | None,
+) -> PlanResult:
+    """Plan for ``problem`` by the goal agenda, else by the full search (module docstring).
+
+    ``search`` runs one search (:data:`SubSearch`); ``start`` is the belief to plan from (None:
+    the problem's initial belief); ``max_nodes`` the run's node limit, which the agenda's
+    searches share and the full search gets whole; ``timeout`` the seconds for all of them.
+    ``progress`` receives each search's statistics with ``stage``: ``"part k of N (P)"``
+    while the agenda adds part P as the k-th of N, ``"full search"`` after it failed.
+
+    The result's statistics add up every search of the run (``max_nodes`` is the run's limit);
+    :attr:`~arrange_up.planning.planner.PlanResult.agenda` records the agenda. When the agenda
+    finds the plan, ``beliefs`` run through its subgoals' plans.
+    """
+    order = goal_order(problem)
+    if order is None:
+        return search(problem, start, max_nodes, timeout, progress)
+    started = time.monotonic()
+
+    def left() -> float | None:
+        return None if timeout is None else max(0.0, timeout - (time.monotonic() - started))
+
+    def staged(stage: str) -> ProgressCallback | None:
+        if progress is None:
+            return None
+        return lambda stats: progress({**stats, "stage": stage})
+
+    per_part = subgoal_budget(max_nodes, len(order))
+    done: list[tuple[tuple[str, ...], PlanResult]] = []
+    spent: list[PlanResult] = []
+    failed: set[tuple[int, int]] = set()  # (parts finished before, parts added) that failed
+    position, size = 0, 1
+    expanded = 0
+    while position < len(order):
+        group = order[position : position + size]
+        nodes = min(size * per_part, max_nodes - expanded)
+        if nodes <= 0:
+            break
+        belief = done[-1][1].beliefs[-1] if done else start  # type: ignore[index]  # solved
+        stage = f"part {position + size} of {len(order)} ({'+'.join(group)})"
+        result = search(
+            restricted(problem, order[: position + size]), belief, nodes, left(), staged(stage)
+        )
+        spent.append(result)
+        expanded += result.statistics.expanded
+        if result.solved:
+            done.append((group, result))
+            position, size = position + size, 1
+            continue
+        if result.status in _FINAL:
+            record = _record(order, done, None, expanded, group)
+            return _with_spent(result, spent, record, max_nodes)
+        failed.add((position, size))
+        retry = _regroup(position, size, done, failed, len(order))
+        if retry is None:
+            break
+        position, size = retry
+        while sum(len(group) for group, _ in done) > position:
+            done.pop()  # backtracking: the previous subgoal is searched again
+    else:
+        return _joined(done, spent, _record(order, done, "agenda", expanded, None), max_nodes)
+    failed_at = order[position : position + size]
+    full = search(problem, start, max_nodes, left(), staged("full search"))
+    record = _record(order, done, "full search" if full.solved else None, expanded, failed_at)
+    return _with_spent(full, spent, record, max_nodes)
+
+
+def _regroup(
+    position: int,
+    size: int,
+    done: list[tuple[tuple[str, ...], PlanResult]],
+    failed: set[tuple[int, int]],
+    parts: int,
+) -> tuple[int, int] | None:
+    """The next attempt after adding ``size`` parts at ``position`` failed: the same parts and
+    the next one, else the previous subgoal's parts and these, from before it; None when both
+    were tried or exceed :data:`MAX_GROUP`."""
+    if size < MAX_GROUP and position + size < parts and (position, size + 1) not in failed:
+        return position, size + 1
+    if done:
+        previous = len(done[-1][0])
+        if previous + size <= MAX_GROUP and (position - previous, previous + size) not in failed:
+            return position - previous, previous + size
+    return None
+
+
+def _record(
+    order: tuple[str, ...],
+    done: list[tuple[tuple[str, ...], PlanResult]],
+    solved_by: str | None,
+    expanded: int,
+    failed_at: tuple[str, ...] | None,
+) -> AgendaRecord:
+    return AgendaRecord(order, tuple(group for group, _ in done), solved_by, expanded, failed_at)
+
+
+def _with_spent(
+    result: PlanResult, spent: list[PlanResult], record: AgendaRecord, max_nodes: int
+) -> PlanResult:
+    """``result`` (the run's last search) with the statistics and refusals of every search of
+    the run, and the agenda's record."""
+    earlier = spent[:-1] if spent and spent[-1] is result else spent
+    return dataclasses.replace(result.after(earlier, max_nodes), agenda=record)
+
+
+def _joined(
+    done: list[tuple[tuple[str, ...], PlanResult]],
+    spent: list[PlanResult],
+    record: AgendaRecord,
+    max_nodes: int,
+) -> PlanResult:
+    """The agenda's plan: its subgoals' plans and beliefs one after the other, with the
+    statistics and refusals of every search it ran."""
+    results = [result for _, result in done]
+    actions = tuple(action for result in results for action in result.actions or ())
+    beliefs = (results[0].beliefs or ())[:1] + tuple(
+        belief for result in results for belief in (result.beliefs or ())[1:]
+    )
+    joined = dataclasses.replace(results[-1], actions=actions, beliefs=beliefs)
+    return _with_spent(joined, [*spent[:-1], joined], record, max_nodes)
