@@ -7,17 +7,17 @@ seed or size given as ``True`` is a mistake, and every check here refuses boolea
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeGuard
 
 __all__ = ["check_count", "is_integer", "is_number"]
 
 
-def is_integer(value: Any) -> bool:
+def is_integer(value: object) -> TypeGuard[int]:
     """True for an ``int`` that is not a ``bool``."""
     return isinstance(value, int) and not isinstance(value, bool)
 
 
-def is_number(value: Any) -> bool:
+def is_number(value: object) -> TypeGuard[float]:
     """True for an ``int`` or ``float`` that is not a ``bool`` (NaN and infinities included)."""
     return isinstance(value, int | float) and not isinstance(value, bool)
 

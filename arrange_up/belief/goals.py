@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from arrange_up.belief.states import symmetry_period
-from arrange_up.model.problem import ArrangementProblem
+from arrange_up.model.problem import ArrangementProblem, as_triple
 from arrange_up.model.world import WorldState
 
 #: Numerical slack on tolerance comparisons (inches / radians).
@@ -102,7 +102,8 @@ class GoalTest:
         coords = self.coordinates(poses, names)
         if coords is None:
             return None
-        return np.maximum(np.abs(coords - self.targets) - self.tolerance - EPS, 0.0)
+        beyond: np.ndarray = np.maximum(np.abs(coords - self.targets) - self.tolerance - EPS, 0.0)
+        return beyond
 
     # -- tests -----------------------------------------------------------------------------
     def satisfied_array(self, poses: np.ndarray, names: Sequence[str]) -> bool:
@@ -136,7 +137,7 @@ class GoalTest:
             if name in self.put_away
         )
         return left + tuple(
-            PartMiss(part, False, tuple(float(v) for v in worst[i]))  # type: ignore[arg-type]
+            PartMiss(part, False, as_triple(float(v) for v in worst[i]))
             for i, part in enumerate(self.parts)
             if np.any(worst[i] > 0.0)
         )

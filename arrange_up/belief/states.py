@@ -27,7 +27,14 @@ from functools import cache, cached_property
 import numpy as np
 
 from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose, Shape
+from arrange_up.model.problem import (
+    ArrangementProblem,
+    HalfWidths,
+    ObjectKind,
+    Pose,
+    Shape,
+    as_triple,
+)
 from arrange_up.model.world import WorldState
 
 TWO_PI = 2.0 * math.pi
@@ -133,8 +140,8 @@ class ObjectInterval:
     @classmethod
     def from_bounds(cls, low: Sequence[float], high: Sequence[float]) -> ObjectInterval:
         return cls(
-            tuple(0.5 * (lo + hi) for lo, hi in zip(low, high, strict=True)),  # type: ignore[arg-type]
-            tuple(0.5 * (hi - lo) for lo, hi in zip(low, high, strict=True)),  # type: ignore[arg-type]
+            as_triple(0.5 * (lo + hi) for lo, hi in zip(low, high, strict=True)),
+            as_triple(0.5 * (hi - lo) for lo, hi in zip(low, high, strict=True)),
         )
 
 
@@ -220,14 +227,14 @@ class ParticleBelief:
         # -0.0 == 0.0, so hash the array with its zeros made positive (adding 0.0 does that).
         return hash((self._names, (self.poses + 0.0).tobytes()))
 
-    def __getstate__(self) -> dict:
+    def __getstate__(self) -> dict[str, object]:
         # the hash is Python's, of a tuple holding strings: salted per process, so a belief
         # that crosses to another process (a worker simulating a successor) hashes anew
         state = dict(self.__dict__)
         del state["_hash"]
         return state
 
-    def __setstate__(self, state: dict) -> None:
+    def __setstate__(self, state: dict[str, object]) -> None:
         self.__dict__.update(state)
         self.poses.flags.writeable = False
         self._hash = self._hash_of_poses()
@@ -301,7 +308,7 @@ def sample_initial_particles(
             poses = {}
             for entry in problem.initial:
                 u = rng.uniform(-1.0, 1.0, size=3)
-                poses[entry.name] = tuple(
+                poses[entry.name] = as_triple(
                     float(entry.pose[k] + u[k] * entry.uncertainty[k]) for k in range(3)
                 )
             state = WorldState.from_mapping(problem, poses)

@@ -63,8 +63,8 @@ def _failure_lines(
                 bound = f"±{units.angle_out(tol[2] or 0.0):g} {units.angle}"
             elif miss.dimension in ("x", "y"):
                 worst = f"{units.length_out(miss.worst):.3g} {units.length}"
-                index = 0 if miss.dimension == "x" else 1
-                bound = f"±{units.length_out(tol[index]):g} {units.length}"
+                along = tol[0] if miss.dimension == "x" else tol[1]
+                bound = f"±{units.length_out(along):g} {units.length}"
             else:
                 lines.append(f"    {miss.part} {miss.dimension}: {miss.rollouts}")
                 continue
@@ -74,19 +74,20 @@ def _failure_lines(
             )
     if failures.action_failed:
         lines.append(f"  action failed    {failures.action_failed:>7}")
-        for entry in failures.action_failures:
+        for failure in failures.action_failures:
             lines.append(
-                f"    {_describe_action(actions, entry.action)}: {entry.rollouts}: {entry.reason}"
+                f"    {_describe_action(actions, failure.action)}: {failure.rollouts}: "
+                f"{failure.reason}"
             )
     if failures.not_at_rest:
         lines.append(f"  not at rest      {failures.not_at_rest:>7}")
-        for entry in failures.not_at_rest_actions:
-            lines.append(f"    {_describe_action(actions, entry.action)}: {entry.rollouts}")
+        for moving in failures.not_at_rest_actions:
+            lines.append(f"    {_describe_action(actions, moving.action)}: {moving.rollouts}")
     if failures.off_table:
         lines.append(f"  off table        {failures.off_table:>7}")
-        for entry in failures.off_table_actions:
+        for fallen in failures.off_table_actions:
             lines.append(
-                f"    {_describe_action(actions, entry.action)}: {entry.object} {entry.rollouts}"
+                f"    {_describe_action(actions, fallen.action)}: {fallen.object} {fallen.rollouts}"
             )
     return lines
 

@@ -19,7 +19,7 @@ import signal
 import sys
 import tempfile
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
@@ -71,7 +71,7 @@ class OutputFile(click.Path):
 
     name = "output file"
 
-    def __init__(self, suffixes: Sequence[str] = ()) -> None:
+    def __init__(self, suffixes: Iterable[str] = ()) -> None:
         super().__init__(dir_okay=False)
         self.suffixes = tuple(suffix.lower() for suffix in suffixes)
 

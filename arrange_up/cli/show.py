@@ -148,6 +148,7 @@ def show(
     elif output is None:
         fail("expected --output (or --plan with --animate)")
     if plan_file is None:
+        assert output is not None  # refused above: no plan, so no --animate either
         path = draw_problem(loaded, Path(output), dpi=dpi)
         click.echo(f"wrote {path}")
         return

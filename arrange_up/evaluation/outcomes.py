@@ -98,7 +98,7 @@ class Failure:
             detail=data.get("detail"),
             objects=tuple(data.get("objects", ())),
             misses=tuple(
-                GoalMiss(m["part"], tuple(m["dimensions"]), tuple(m["excess"]))  # type: ignore[arg-type]
+                GoalMiss(m["part"], tuple(m["dimensions"]), tuple(m["excess"]))
                 for m in data.get("misses", ())
             ),
         )

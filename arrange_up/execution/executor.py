@@ -29,7 +29,7 @@ from arrange_up.belief.states import sample_initial_particles
 from arrange_up.evaluation.outcomes import Failure
 from arrange_up.evaluation.rollouts import Rollouts
 from arrange_up.execution.observations import Observation, Sensor
-from arrange_up.model.problem import ArrangementProblem, Uncertainty
+from arrange_up.model.problem import ArrangementProblem, Uncertainty, as_triple
 from arrange_up.model.world import Action, WorldState
 
 __all__ = ["ExecutionFailed", "Executor", "SimulatedExecutor", "scaled_problem"]
@@ -80,7 +80,7 @@ def scaled_problem(problem: ArrangementProblem, scale: float) -> ArrangementProb
         manipulator_density=widen(unc.manipulator_density),
     )
     initial = tuple(
-        dataclasses.replace(e, uncertainty=tuple(v * scale for v in e.uncertainty))
+        dataclasses.replace(e, uncertainty=as_triple(v * scale for v in e.uncertainty))
         for e in problem.initial
     )
     return dataclasses.replace(problem, uncertainty=scaled, initial=initial)

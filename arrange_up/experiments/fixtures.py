@@ -635,9 +635,9 @@ def plot_fixture_experiment(rows: Sequence[dict[str, str]], output_dir: Path) ->
     output_dir = Path(output_dir)
     written = [_plot_overview(summary, problems, output_dir / "fixtures-overview.png")]
     for problem in problems:
-        rows = [s for s in summary if s.problem == problem]
+        problem_rows = [s for s in summary if s.problem == problem]
         png = output_dir / f"fixtures-{Path(problem).stem if _is_file(problem) else problem}.png"
-        written.append(_plot_problem(problem, rows, png))
+        written.append(_plot_problem(problem, problem_rows, png))
     return written
 
 
@@ -657,7 +657,7 @@ def _plot_overview(summary: Sequence[SummaryRow], problems: list[str], png: Path
         repaired = [s for s in summary if s.problem == problem and s.stage == REPAIRED]
         # The thesis's overview (Figure 4-14) used 150 particles; else the largest count run.
         best = next((s for s in repaired if s.particles == 150), repaired[-1] if repaired else None)
-        if best is not None:
+        if best is not None and best.particles is not None:
             used.add(best.particles)
         if nominal.solved == 0:
             ax.text(i, 2, "no nominal plan", ha="center", va="bottom", fontsize=8)

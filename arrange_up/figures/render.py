@@ -547,7 +547,7 @@ class _UnitLocator(MaxNLocator):
         self.factor = factor
 
     def tick_values(self, vmin: float, vmax: float) -> Any:
-        return super().tick_values(vmin / self.factor, vmax / self.factor) * self.factor
+        return np.asarray(super().tick_values(vmin / self.factor, vmax / self.factor)) * self.factor
 
 
 def unit_axes(ax: Axes, units: Units, xlabel: str = "x", ylabel: str = "y") -> None:

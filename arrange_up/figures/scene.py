@@ -181,7 +181,11 @@ def draw_goal_outlines(
     artists: list[Any] = []
     half = render.goal_tolerance_half_widths(problem)
     for name, target in goal.targets:
-        pose = compose(reference_pose, target) if goal.is_relative else target
+        pose = (
+            compose(reference_pose, target)
+            if goal.is_relative and reference_pose is not None
+            else target
+        )
         spec = problem.object(name)
         artists += render.draw_object(
             ax, spec, pose, color=GOAL_COLOR, fill=False, linewidth=2.0, zorder=3.5

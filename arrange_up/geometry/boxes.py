@@ -3,12 +3,13 @@ sweeps, and the table's walls."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 import shapely.geometry.base
 
 from arrange_up.geometry.polygons import Polygon, _points_array
+from arrange_up.geometry.se2 import Point
 
 Box = tuple[float, float, float, float]
 """``(xmin, ymin, xmax, ymax)``."""
@@ -28,7 +29,12 @@ __all__ = [
 ]
 
 
-def box_of(geom_or_points) -> Box:
+def box_of(
+    geom_or_points: shapely.geometry.base.BaseGeometry
+    | np.ndarray
+    | Sequence[Point]
+    | Sequence[Sequence[Point]],
+) -> Box:
     """Bounding box of a shapely geometry, an ``(N, 2)`` point set, or a sequence of polygons.
 
     Raises ``ValueError`` for empty input.

@@ -16,13 +16,14 @@ from functools import lru_cache
 
 import numpy as np
 import shapely
+import shapely.geometry.base
 from shapely.geometry import box as shapely_box
 
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.boxes import Box, box_corners, wall_boxes
 from arrange_up.geometry.polygons import convex_penetration
 from arrange_up.geometry.se2 import transform_points
-from arrange_up.model.problem import ArrangementProblem, HalfWidths, Pose
+from arrange_up.model.problem import ArrangementProblem, HalfWidths, Pose, as_triple
 from arrange_up.model.world import WorldState
 
 #: Overlap area (square inches) below which two footprints count as touching, not overlapping.
@@ -78,10 +79,12 @@ class CollisionChecker:
         return False
 
     # -- shadows -----------------------------------------------------------------------------
-    def _shadow_box_uncached(self, name: str, pose: Pose, half: HalfWidths):
+    def _shadow_box_uncached(self, name: str, pose: Pose, half: HalfWidths) -> Box:
         return geometry.shadow_box(self.shapes[name].parts, pose, half)
 
-    def _shadow_hull_uncached(self, name: str, pose: Pose, half: HalfWidths):
+    def _shadow_hull_uncached(
+        self, name: str, pose: Pose, half: HalfWidths
+    ) -> shapely.geometry.base.BaseGeometry:
         parts = self.shapes[name].parts
         if name not in self.concave:
             return geometry.shadow_hull(parts, pose, half)
@@ -92,43 +95,57 @@ class CollisionChecker:
             return (self.shadow_box(name, pose, half),)
         return tuple(geometry.shadow_box([part], pose, half) for part in self.shapes[name].parts)
 
-    def shadow_box(self, name: str, pose: Pose, half: HalfWidths):
-        return self._shadow_box(name, tuple(pose), tuple(half))
+    def shadow_box(self, name: str, pose: Pose, half: HalfWidths) -> Box:
+        return self._shadow_box(name, as_triple(pose), as_triple(half))
 
-    def shadow_hull(self, name: str, pose: Pose, half: HalfWidths):
+    def shadow_hull(
+        self, name: str, pose: Pose, half: HalfWidths
+    ) -> shapely.geometry.base.BaseGeometry:
         """The object's shadow: a convex polygon containing it at every pose of the interval
         (:func:`~arrange_up.geometry.shadows.shadow_hull`), or for a concave object (one whose
         convex parts do not fill their hull: an L, a T, a U) the union of its parts' shadows,
         so that its notches stay open to what fits in them."""
-        return self._shadow_hull(name, tuple(pose), tuple(half))
+        return self._shadow_hull(name, as_triple(pose), as_triple(half))
 
     def piece_boxes(self, name: str, pose: Pose, half: HalfWidths) -> tuple[Box, ...]:
         """The shadow boxes of the object's convex parts if it is concave (their union holds
         its shadow, notches left open), else its one shadow box."""
-        return self._piece_boxes(name, tuple(pose), tuple(half))
+        return self._piece_boxes(name, as_triple(pose), as_triple(half))
 
     def shadows_overlap(
         self, a: tuple[str, Pose, HalfWidths], b: tuple[str, Pose, HalfWidths]
     ) -> bool:
         """True if the belief shadows of two objects may overlap (boxes, then hulls)."""
-        return self._overlap(self.shadow_box(*a), a[0], tuple(a[1]), tuple(a[2]), b)
+        return self._overlap(self.shadow_box(*a), a[0], as_triple(a[1]), as_triple(a[2]), b)
 
-    def _overlap(self, box, name: str, pose: Pose, half: HalfWidths, other, other_box=None) -> bool:
+    def _overlap(
+        self,
+        box: Box,
+        name: str,
+        pose: Pose,
+        half: HalfWidths,
+        other: tuple[str, Pose, HalfWidths],
+        other_box: Box | None = None,
+    ) -> bool:
         """:meth:`shadows_overlap` of ``(name, pose, half)``, whose shadow box is ``box``
         (tuples), and ``other``, whose shadow box is ``other_box`` if given."""
         if other_box is None:
             other_box = self.shadow_box(*other)
         if not geometry.boxes_overlap(box, other_box, -CLEARANCE):
             return False
-        return self._hulls_meet(name, pose, half, other[0], tuple(other[1]), tuple(other[2]))
+        return self._hulls_meet(
+            name, pose, half, other[0], as_triple(other[1]), as_triple(other[2])
+        )
 
-    def _hulls_meet_uncached(self, a, a_pose, a_half, b, b_pose, b_half) -> bool:
+    def _hulls_meet_uncached(
+        self, a: str, a_pose: Pose, a_half: HalfWidths, b: str, b_pose: Pose, b_half: HalfWidths
+    ) -> bool:
         hull_a, hull_b = self.shadow_hull(a, a_pose, a_half), self.shadow_hull(b, b_pose, b_half)
         return hull_a.distance(hull_b) < CLEARANCE
 
     def shadow_hits_fixed(self, name: str, pose: Pose, half: HalfWidths) -> bool:
         """True if the object's shadow may touch a wall or an obstacle."""
-        return self._hits_fixed(name, tuple(pose), tuple(half))
+        return self._hits_fixed(name, as_triple(pose), as_triple(half))
 
     def _hits_fixed_uncached(self, name: str, pose: Pose, half: HalfWidths) -> bool:
         box = self.shadow_box(name, pose, half)
@@ -162,7 +179,7 @@ class CollisionChecker:
         """The place precondition: ``name``'s shadow touches no other shadow, wall or obstacle.
         ``boxes``: the others' shadow boxes in their order, when the caller has them (an
         action generator tests many poses against one belief's shadows)."""
-        pose, half = tuple(pose), tuple(half)
+        pose, half = as_triple(pose), as_triple(half)
         if self._hits_fixed(name, pose, half):
             return False
         box = self._shadow_box(name, pose, half)
@@ -174,7 +191,7 @@ class CollisionChecker:
         )
 
 
-def _box_geom(box):
+def _box_geom(box: Box) -> shapely.Polygon:
     return shapely_box(*box)
 
 

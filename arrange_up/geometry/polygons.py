@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from arrange_up.geometry.se2 import Point
 
@@ -44,7 +45,7 @@ __all__ = [
 ]
 
 
-def _points_array(poly: Sequence[Point] | np.ndarray) -> np.ndarray:
+def _points_array(poly: npt.ArrayLike) -> np.ndarray:
     """``poly`` as a float ``(N, 2)`` array; ``ValueError`` if it is not a list of pairs."""
     arr = np.asarray(poly, dtype=float)
     if arr.size == 0:
@@ -59,7 +60,7 @@ def _as_polygon(arr: np.ndarray) -> Polygon:
     return tuple((float(x), float(y)) for x, y in arr.tolist())
 
 
-def polygon_signed_area(poly: Sequence[Point]) -> float:
+def polygon_signed_area(poly: Sequence[Point] | np.ndarray) -> float:
     """Signed area by the shoelace formula: positive for CCW, negative for CW.
 
     Any sequence of points is accepted (no validity check); fewer than 3 points give ``0.0``.
@@ -131,12 +132,15 @@ def parts_centroid(parts: Sequence[Sequence[Point]]) -> Point:
 
 def _orient(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Twice the signed area of triangles ``(a, b, c)``, vectorised over leading axes."""
-    return (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (b[..., 1] - a[..., 1]) * (
-        c[..., 0] - a[..., 0]
-    )
+    twice_area: np.ndarray = (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (
+        b[..., 1] - a[..., 1]
+    ) * (c[..., 0] - a[..., 0])
+    return twice_area
 
 
-def _segments_intersect(p1, p2, q1, q2) -> np.ndarray:
+def _segments_intersect(
+    p1: np.ndarray, p2: np.ndarray, q1: np.ndarray, q2: np.ndarray
+) -> np.ndarray:
     """Whether closed segments ``p1p2`` and ``q1q2`` share a point (vectorised).
 
     Standard orientation test: the segments meet iff each one's endpoints are not strictly on
@@ -154,7 +158,8 @@ def _segments_intersect(p1, p2, q1, q2) -> np.ndarray:
         & (np.minimum(p1[..., 1], p2[..., 1]) <= np.maximum(q1[..., 1], q2[..., 1]))
         & (np.minimum(q1[..., 1], q2[..., 1]) <= np.maximum(p1[..., 1], p2[..., 1]))
     )
-    return straddle & boxes
+    meet: np.ndarray = straddle & boxes
+    return meet
 
 
 def polygon_problem(poly: Sequence[Point]) -> str | None:

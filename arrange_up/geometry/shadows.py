@@ -66,8 +66,8 @@ def _convex_hull_points(p: np.ndarray) -> np.ndarray:
     if len(pts) <= 2:
         return np.asarray(pts, dtype=float).reshape(-1, 2)
 
-    def half(seq: list) -> list:
-        chain: list = []
+    def half(seq: list[Point]) -> list[Point]:
+        chain: list[Point] = []
         for q in seq:
             while len(chain) >= 2 and _cross3(chain[-2], chain[-1], q) <= 0.0:
                 chain.pop()
@@ -95,7 +95,7 @@ def _make_shape_vertices(p: np.ndarray) -> ShapeVertices:
 
 
 @lru_cache(maxsize=4096)
-def _cached_shape_vertices(parts: tuple) -> ShapeVertices:
+def _cached_shape_vertices(parts: tuple[Sequence[Point], ...]) -> ShapeVertices:
     allpts = np.concatenate([_points_array(part) for part in parts])
     return _make_shape_vertices(_convex_hull_points(allpts))
 
@@ -120,7 +120,7 @@ def shape_vertices(parts: Sequence[Sequence[Point]] | np.ndarray | ShapeVertices
             raise ValueError(f"expected an (N, 2) array of points, got shape {p.shape}")
         return _make_shape_vertices(p)
     try:
-        return _cached_shape_vertices(parts)  # type: ignore[arg-type]
+        return _cached_shape_vertices(parts)
     except TypeError:  # unhashable (lists)
         allpts = np.concatenate([_points_array(part) for part in parts])
         return _make_shape_vertices(_convex_hull_points(allpts))

@@ -12,8 +12,10 @@ from typing import IO, TypeVar
 
 try:
     import fcntl
+
+    _HAS_FCNTL = True
 except ImportError:  # pragma: no cover - not on POSIX: files are not locked
-    fcntl = None
+    _HAS_FCNTL = False
 
 __all__ = [
     "lock_exclusively",
@@ -29,9 +31,12 @@ R = TypeVar("R")
 def text_place(text: str | bytes, index: int) -> tuple[int, int]:
     """The 1-based ``(line, column)`` of position ``index`` in ``text`` (characters of a
     string, bytes of bytes)."""
-    newline = b"\n" if isinstance(text, bytes) else "\n"
     before = text[:index]
-    return before.count(newline) + 1, len(before) - (before.rfind(newline) + 1) + 1
+    if isinstance(before, bytes):
+        newlines, line_start = before.count(b"\n"), before.rfind(b"\n") + 1
+    else:
+        newlines, line_start = before.count("\n"), before.rfind("\n") + 1
+    return newlines + 1, len(before) - line_start + 1
 
 
 def undecodable_place(data: bytes, error: UnicodeDecodeError) -> tuple[int, int]:
@@ -44,7 +49,7 @@ def lock_exclusively(handle: IO[bytes]) -> bool:
     """Take an exclusive lock on the open file ``handle`` without waiting; False when another
     process holds one (the lock ends when the handle is closed). Where the platform has no
     ``fcntl``, files are not locked and this returns True."""
-    if fcntl is None:  # pragma: no cover - not on POSIX
+    if not _HAS_FCNTL:  # pragma: no cover - not on POSIX
         return True
     try:
         fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)

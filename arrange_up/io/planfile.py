@@ -36,7 +36,7 @@ import os
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 from arrange_up.counts import is_number
 from arrange_up.io.files import undecodable_place
@@ -48,6 +48,7 @@ from arrange_up.model.problem import (
     Controller,
     ControllerKind,
     ObjectKind,
+    as_triple,
     problem_hash,
 )
 from arrange_up.model.units import ANGLE_UNITS, LENGTH_UNITS, Units
@@ -108,7 +109,7 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
             or not all(_is_number(v) for v in pose)
         ):
             raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {_shown(pose)}")
-        internal = units.pose_in(tuple(pose))  # type: ignore[arg-type]
+        internal = units.pose_in(as_triple(pose))
         reason = angle_problem(internal[2], units.angle)
         if reason is not None:
             raise PlanFileError(f"{where}.pose[2]: angle {pose[2]:g} {units.angle}: {reason}")
@@ -243,12 +244,12 @@ def _read_document(path: Path) -> Any:
             "file (a JSON object)"
         ) from None
     except ValueError as error:  # an integer of more digits than Python converts
-        line, column, digits = long_number(text)
+        number_line, number_column, digits = long_number(text)
         if not digits:
             raise PlanFileError(f"{path}: not a plan file: {error}") from None
         raise PlanFileError(
-            f"{path}:{line}:{column}: a number of {digits} digits; expected a finite number "
-            "(a double, at most about 1e308)"
+            f"{path}:{number_line}:{number_column}: a number of {digits} digits; expected a "
+            "finite number (a double, at most about 1e308)"
         ) from None
 
 
@@ -412,7 +413,7 @@ def _round(value: float) -> float:
     return float(f"{value:.12g}")
 
 
-def _is_number(value: Any) -> bool:
+def _is_number(value: object) -> TypeGuard[float]:
     """A finite number that converts to a double (a 400-digit integer does not)."""
     if not is_number(value):
         return False

@@ -341,8 +341,8 @@ def _collision(footprints: list[Any], others: Any, tree: STRtree | None) -> tupl
         for i, k in zip(pairs[0].tolist(), pairs[1].tolist(), strict=True):
             if _overlap(footprints[i], others[k]):
                 return i, -1 - k
-    for j, pairs in _overlapping(footprints).items():
-        return j, pairs[0][0]
+    for j, overlaps in _overlapping(footprints).items():
+        return j, overlaps[0][0]
     return None
 
 

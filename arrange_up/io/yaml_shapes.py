@@ -102,15 +102,18 @@ class ShapeReader(NodeReader):
             return None
         # Refused before its vertices are read (one extra entry may be a closing vertex).
         if len(node.value) > geometry.MAX_POLYGON_VERTICES + 1:
-            return self.too_many_vertices(node, len(node.value))
-        values = [self.vector(item, ("x", "y")) for item in node.items()]
-        if any(v is None for v in values):
+            self.too_many_vertices(node, len(node.value))
             return None
-        points = [(self.units.length_in(v[0]), self.units.length_in(v[1])) for v in values]  # type: ignore[index]
+        values = [self.vector(item, ("x", "y")) for item in node.items()]
+        vectors = [v for v in values if v is not None]
+        if len(vectors) < len(values):
+            return None
+        points = [(self.units.length_in(v[0]), self.units.length_in(v[1])) for v in vectors]
         if len(points) > 3 and points[-1] == points[0]:
             points.pop()  # an explicitly closed outline: the closing vertex repeats the first
         if len(points) > geometry.MAX_POLYGON_VERTICES:
-            return self.too_many_vertices(node, len(points))
+            self.too_many_vertices(node, len(points))
+            return None
         self.vertices += len(points)
         if self.vertices > MAX_PROBLEM_VERTICES:
             if self.vertices - len(points) <= MAX_PROBLEM_VERTICES:  # report it once

@@ -506,10 +506,10 @@ class NodeReader:
             return None
         article = "an" if what[0] in "aeiou" else "a"
         values = [self.number(item, f"{article} {what}") for item in items]
-        if any(v is None for v in values):
+        numbers = tuple(v for v in values if v is not None)
+        if len(numbers) < len(values):
             return None
-        result = tuple(values)  # type: ignore[arg-type]
-        return self.positive(node, result, what) if positive else result
+        return self.positive(node, numbers, what) if positive else numbers
 
 
 def _char(character: Any) -> str:

@@ -25,7 +25,7 @@ import functools
 import hashlib
 import json
 import math
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from arrange_up.model.units import Units
@@ -42,6 +42,13 @@ ConvexPolygon = tuple[Point, ...]
 WALL_EDGES: tuple[str, ...] = ("left", "right", "bottom", "top")
 STANDARD_GRAVITY = 386.09
 """Standard gravity in in/s^2: the table friction's normal force per unit mass."""
+
+
+def as_triple(values: Iterable[float]) -> tuple[float, float, float]:
+    """``values`` as a 3-tuple (a :data:`Pose` or :data:`HalfWidths`), each element as given;
+    ``ValueError`` unless there are exactly three."""
+    a, b, c = values
+    return (a, b, c)
 
 
 class ObjectKind(enum.StrEnum):

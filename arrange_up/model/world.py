@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose
+from arrange_up.model.problem import ArrangementProblem, HalfWidths, ObjectKind, Pose, as_triple
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class WorldState:
             raise KeyError(f"unknown objects {sorted(unknown)} in problem {problem.name!r}")
         return cls(
             tuple(
-                (spec.name, tuple(float(v) for v in poses[spec.name]))  # type: ignore[misc]
+                (spec.name, as_triple(float(v) for v in poses[spec.name]))
                 for spec in problem.objects
                 if spec.name in poses
             )

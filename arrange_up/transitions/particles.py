@@ -54,7 +54,7 @@ from arrange_up.belief.states import (
 )
 from arrange_up.geometry import shapes as geometry
 from arrange_up.geometry.se2 import rotate
-from arrange_up.model.problem import ArrangementProblem, Pose
+from arrange_up.model.problem import ArrangementProblem, Pose, as_triple
 from arrange_up.model.world import (
     Action,
     ActionNoise,
@@ -285,7 +285,7 @@ class ParticleSemantics:
         states = []
         for state, offset in zip(belief.particles, offsets, strict=True):
             poses = state.as_dict()
-            poses[place.obj] = tuple(a + b for a, b in zip(place.pose, offset, strict=True))
+            poses[place.obj] = as_triple(a + b for a, b in zip(place.pose, offset, strict=True))
             states.append(self.frame.canonical(WorldState.from_mapping(self.problem, poses)))
         return ParticleBelief(tuple(states))
 

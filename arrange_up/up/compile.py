@@ -179,10 +179,7 @@ def to_up(
         ]
         for fluent in rel_fluents:
             up.add_fluent(fluent, default_initial_value=0)
-        rel = {
-            part: tuple(f(objects[part]) for f in rel_fluents)  # type: ignore[misc]
-            for part in problem.goal.parts
-        }
+        rel = {part: tuple(f(objects[part]) for f in rel_fluents) for part in problem.goal.parts}
     pose_fluents = PoseFluents(
         fluents,
         movable_names,
