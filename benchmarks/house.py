@@ -81,6 +81,7 @@ TOP_SHOWN = 10
 
 #: The rooms, earliest in the pipeline first; rooms on one floor are peers (docs/design/README.md).
 ROOMS: tuple[tuple[str, ...], ...] = (
+    ("counts",),
     ("search", "parallel", "model"),
     ("geometry",),
     ("io",),
