@@ -82,6 +82,7 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, wait
+from dataclasses import dataclass
 from itertools import islice
 from typing import Any, Generic, TypeVar
 
@@ -593,6 +594,34 @@ def check_runner_options(
         check_count("workers", workers)
     if scheduler is not None and backend != "dask":
         raise ValueError("a scheduler address needs the dask backend")
+
+
+@dataclass(frozen=True)
+class RunnerConfig:
+    """Where independent work runs (:func:`get_runner`'s arguments as one value): ``"local"``
+    with ``workers`` processes (1: in this process; None: every core this process may use), or
+    ``"dask"``, a LocalCluster of ``workers`` processes or the cluster at ``scheduler``. Bad
+    options raise ``ValueError`` when it is made (:func:`check_runner_options`); nothing starts
+    until :meth:`runner` is called."""
+
+    workers: int | None = 1
+    backend: str = "local"
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        check_runner_options(self.backend, self.workers, self.scheduler)
+
+    def runner(self) -> Runner:
+        """The (cached) runner these options name (see :func:`get_runner`)."""
+        return get_runner(self.backend, self.workers, self.scheduler)
+
+    def as_options(self) -> dict[str, Any]:
+        """The options as :func:`get_runner`'s keyword arguments."""
+        return {"workers": self.workers, "backend": self.backend, "scheduler": self.scheduler}
+
+
+SERIAL = RunnerConfig()
+"""One worker, in this process."""
 
 
 def get_runner(

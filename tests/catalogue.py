@@ -23,6 +23,7 @@ from functools import cache
 
 from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.problem import SERVO_CONTROLLER, ArrangementProblem
+from arrange_up.planning.config import PlanConfig
 from arrange_up.planning.task import BeliefTask
 
 TEXTS: dict[str, str] = {
@@ -232,16 +233,7 @@ def particle_task(
 ) -> Iterator[BeliefTask]:
     """The search task ``plan(problem, particles=particles, seed=seed, workers=1)`` builds
     (particle semantics, the inadmissible heuristic, dominance, no variety), closed on leaving."""
-    task = BeliefTask.build(
-        problem,
-        semantics="particles",
-        particles=particles,
-        seed=seed,
-        workers=1,
-        heuristic="inadmissible",
-        dominance=True,
-        variety=False,
-    )
+    task = BeliefTask.build(problem, PlanConfig(particles=particles, seed=seed))
     try:
         yield task
     finally:

@@ -30,9 +30,9 @@ from arrange_up.cli.shared import (
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.parallel import BackendUnavailableError, available_cores
+from arrange_up.parallel import BackendUnavailableError, RunnerConfig, available_cores
+from arrange_up.planning.config import DEFAULT_MAX_NODES, DEFAULT_WEIGHT, PlanConfig, SearchConfig
 from arrange_up.planning.heuristics import HEURISTICS
-from arrange_up.planning.planner import DEFAULT_MAX_NODES, DEFAULT_WEIGHT
 from arrange_up.planning.planner import plan as run_plan
 from arrange_up.planning.validation import check_validate
 
@@ -74,7 +74,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 @click.argument("problem")
 @click.option(
     "--semantics",
-    default=library_default(run_plan, "semantics"),
+    default=library_default(PlanConfig, "semantics"),
     show_default=True,
     help="Belief transition: deterministic (nominal, one particle, no noise), particles "
     "(thesis §3.1: simulate every particle) or cbst (thesis §3.2: interval beliefs and the "
@@ -83,7 +83,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 @click.option(
     "--particles",
     type=click.IntRange(1, 100_000),
-    default=library_default(run_plan, "particles"),
+    default=library_default(PlanConfig, "particles"),
     show_default=True,
     help="Particles per belief (particle semantics; deterministic plans from one, CBST from "
     "intervals).",
@@ -100,7 +100,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 )
 @click.option(
     "--heuristic",
-    default=library_default(run_plan, "heuristic"),
+    default=library_default(SearchConfig, "heuristic"),
     show_default=True,
     type=click.Choice(HEURISTICS),
     help="Search heuristic (thesis §2.2.2, §3.2).",
@@ -115,7 +115,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 @click.option("--no-dominance", is_flag=True, help="Do not prune dominated beliefs.")
 @click.option(
     "--agenda/--no-agenda",
-    default=library_default(run_plan, "agenda"),
+    default=library_default(SearchConfig, "agenda"),
     show_default=True,
     help="Search one part at a time, in an order taken from the goal's geometry (the goal "
     "agenda), before the whole goal; --no-agenda searches the whole goal only.",
@@ -219,25 +219,23 @@ def plan(
                 def update(stats: dict[str, Any]) -> None:
                     display.update(task, description=_status_line(stats))
 
-            result = run_plan(
-                loaded,
+            config = PlanConfig(
                 semantics=semantics,
                 particles=particles,
                 seed=seed,
-                max_nodes=max_nodes,
-                timeout=timeout,
-                heuristic=heuristic,
-                weight=weight,
-                dominance=not no_dominance,
-                agenda=agenda,
-                workers=workers,
-                backend=backend,
-                scheduler=scheduler,
-                progress=update,
                 model=model,
                 validate=validate,
-                should_stop=interrupted,
+                search=SearchConfig(
+                    weight=weight,
+                    heuristic=heuristic,
+                    dominance=not no_dominance,
+                    max_nodes=max_nodes,
+                    timeout=timeout,
+                    agenda=agenda,
+                ),
+                runner=RunnerConfig(workers=workers, backend=backend, scheduler=scheduler),
             )
+            result = run_plan(loaded, config, progress=update, should_stop=interrupted)
     except BackendUnavailableError as error:  # dask missing, or the scheduler unreachable
         fail(f"--backend {backend}: {error}")
     except (LookupError, ValueError) as error:  # a --model not found, unsound or not for cbst

@@ -56,6 +56,12 @@ Heuristic = Callable[[ParticleBelief], float]
 BLOCKING_CACHE = 200_000
 
 
+def check_heuristic(name: str) -> None:
+    """``ValueError`` naming :data:`HEURISTICS` unless ``name`` is one of them."""
+    if name not in HEURISTICS:
+        raise ValueError(f"unknown heuristic {name!r}; expected one of {', '.join(HEURISTICS)}")
+
+
 def make_heuristic(
     name: str,
     problem: ArrangementProblem,
@@ -72,8 +78,7 @@ def make_heuristic(
     the filter is itself a heuristic, and where it leaves nothing to search the planner searches
     again without it.
     """
-    if name not in HEURISTICS:
-        raise ValueError(f"unknown heuristic {name!r}; expected one of {', '.join(HEURISTICS)}")
+    check_heuristic(name)
     ordering = _OrderingFilter(problem, goal, checker, generator)
     violated = ordering.violated if ordering_filter else _never
 

@@ -15,7 +15,6 @@ import time
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
-from pathlib import Path
 from typing import Any, Self
 
 from arrange_up.belief.goals import PartMiss
@@ -23,8 +22,14 @@ from arrange_up.belief.states import ParticleBelief
 from arrange_up.io.planfile import plan_document
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
-from arrange_up.parallel import Runner, SerialRunner, check_runner_options, get_runner
+from arrange_up.parallel import SERIAL, Runner, SerialRunner
 from arrange_up.planning.agenda import AgendaRecord, plan_by_agenda
+from arrange_up.planning.config import (
+    DEFAULT_MAX_NODES,
+    DEFAULT_WEIGHT,
+    PlanConfig,
+    SearchConfig,
+)
 from arrange_up.planning.fitting import too_large, unfit_parts
 from arrange_up.planning.successors import SuccessorEvaluator, WorkerSpec
 from arrange_up.planning.task import VARIETY_SPLIT, BeliefTask
@@ -46,10 +51,12 @@ __all__ = [
     "DEFAULT_WEIGHT",
     "VARIETY_SPLIT",
     "PartMiss",
+    "PlanConfig",
     "PlanResult",
     "PlanStatistics",
     "ProgressCallback",
     "SearchSnapshot",
+    "SearchConfig",
     "SearchStatus",
     "plan",
     "too_large",
@@ -254,15 +261,6 @@ class PlanResult:
 ProgressCallback = Callable[[dict[str, Any]], None]
 
 
-DEFAULT_MAX_NODES = 5000
-"""The thesis's node limit (§3.3)."""
-DEFAULT_WEIGHT = 2.0
-"""Weighted A* by default: with the (already inadmissible) per-dimension count, A* spends most
-of its nodes on plateaus of equal f, and weight 2 solves within the node limit problems A* does
-not, for plans an action or two longer (figures in docs/design/planning.md). ``weight=1`` gives
-the thesis's A*."""
-
-
 #: Open entries the workers look ahead into for pushes to simulate: the entries that follow
 #: are mostly places (computed here when asked), so the next pushes lie a few levels down.
 PREFETCH_DEPTH = 8
@@ -270,130 +268,77 @@ PREFETCH_DEPTH = 8
 
 def plan(
     problem: ArrangementProblem,
+    config: PlanConfig | None = None,
     *,
-    semantics: str = "particles",
-    particles: int = 50,
-    seed: int = 0,
-    max_nodes: int | None = None,
-    timeout: float | None = None,
-    heuristic: str = "inadmissible",
-    dominance: bool = True,
-    weight: float = DEFAULT_WEIGHT,
-    deferred: bool = True,
-    workers: int = 1,
-    backend: str = "local",
-    scheduler: str | None = None,
-    tie_break: bool = False,
-    variety: bool = False,
     progress: ProgressCallback | None = None,
     should_stop: Callable[[], bool] | None = None,
-    model: str | Path | None = None,
     start: Any = None,
-    validate: int | None = None,
-    agenda: bool = True,
+    **options: Any,
 ) -> PlanResult:
     """Search for a conformant plan for ``problem``.
 
     Parameters
     ----------
-    semantics
-        The belief transition, by name (see :mod:`arrange_up.transitions`).
-    particles
-        Particles per belief, for particle semantics (``deterministic`` always uses one).
-    seed
-        Makes the run reproducible: initial particles, per-particle noise and (with
-        ``tie_break``) the order among equally good nodes all derive from it.
-    max_nodes
-        Limit on expanded nodes; defaults to the problem's ``planning.max_nodes`` or 5000.
-    timeout
-        Wall-clock seconds for the whole run, validation included: the search returns status
-        ``timeout`` when it runs out; a plan found before it is returned with the validation
-        rollouts that fitted (:attr:`PlanResult.validation` says how many ran).
-    heuristic
-        One of :data:`arrange_up.planning.heuristics.HEURISTICS` (default: the thesis's inadmissible
-        per-dimension count with the part-ordering filter, its fastest configuration).
-    dominance
-        Prune beliefs dominated by an already reached belief (thesis §2.1.2, in its form: a
-        dominated belief is pruned whatever its path cost), with a 0.01 in / 0.01 rad
-        tolerance (see :class:`~arrange_up.belief.states.IntervalDominanceIndex`).
-    weight
-        ``f = g + weight * h``; 1 is A*, the default 2 weighted A* (see :data:`DEFAULT_WEIGHT`).
-    deferred
-        Deferred evaluation: a successor is simulated only when it is taken off the open list,
-        not when generated. Most generated successors are never expanded, and simulating them
-        is where the time goes.
-    workers, backend, scheduler
-        Where successor beliefs are computed (:func:`arrange_up.parallel.get_runner`):
-        ``"local"`` with ``workers`` processes (1: in this process), or ``"dask"``, a
-        LocalCluster of ``workers`` processes or the cluster at ``scheduler``. The workers
-        compute the successors the search will evaluate next while it deals with the current
-        one (:mod:`arrange_up.planning.successors`); the plan and the statistics do not depend
-        on where they run. A semantics that simulates no pushes (``cbst``) always computes
-        them in this process and starts no pool or cluster (nor reaches the scheduler). Bad
-        options raise ``ValueError`` before anything is built
-        (:func:`~arrange_up.parallel.check_runner_options`); for a semantics that simulates
-        pushes, :class:`~arrange_up.parallel.BackendUnavailableError` says that dask is
-        missing or the scheduler cannot be reached.
-    tie_break
-        Break ties among equally good nodes at random from ``seed`` (gives different but
-        equally good plans for different seeds, e.g. for plan repair); default first-in
-        first-out.
-    variety
-        Deliberate variety for nominal plans (plan repair, thesis ch. 4): every push the action
-        generator proposes is, with probability :data:`VARIETY_SPLIT`, offered cut short to a
-        random 40-80% of its distance instead of whole. The draws derive from ``seed`` and the
-        belief, so a run is reproducible, and different seeds search different action sets:
-        they return different plans (pushes in another order, or split in two), where
-        ``tie_break`` alone only reorders the few goal-directed pushes of a belief. Plans stay
-        valid plans of the unchanged problem.
+    config
+        How to plan (:class:`~arrange_up.planning.config.PlanConfig`: semantics, particles,
+        seed, model, validation, the search and the runner); None: the defaults.
+    options
+        Flat overrides of ``config`` by the names of its fields, its search's and its
+        runner's (``plan(problem, semantics="deterministic", max_nodes=100)``; see
+        :meth:`PlanConfig.of <arrange_up.planning.config.PlanConfig.of>`). Bad values raise
+        ``ValueError`` before anything is built, unknown names ``TypeError``.
     progress
         Receives the search statistics so far (``SearchSnapshot.to_json()``) every
-        :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end of each search;
-        the searches a failed validation starts (``validate``) begin again from zero, and
-        their dicts also hold ``search``, the search's number (2, 3, ...).
+        :data:`arrange_up.search.PROGRESS_INTERVAL` seconds and once at the end of each search
+        (with ``stage`` while the goal agenda runs: ``"part k of N (P)"``, ``"full search"``);
+        the searches a failed validation starts begin again from zero, and their dicts also
+        hold ``search``, the search's number (2, 3, ...).
     should_stop
         Polled during the search; returning True cancels it (status ``cancelled``).
-    model
-        The learned model of a semantics that has one (``cbst``: a shipped name or the card
-        of a model ``arrange-up train-cbst`` made); ``None``: the shipped default. A model for
-        another semantics, or one that does not load, raises ``ValueError``.
     start
         The belief to plan from instead of the problem's initial belief, in the semantics'
         representation: a :class:`~arrange_up.belief.states.ParticleBelief` for ``particles``
         and ``deterministic`` (any particle count; one particle plans for that state alone), an
         :class:`~arrange_up.belief.states.IntervalBelief` for ``cbst``. Closed-loop execution
-        replans from its posterior this way (:mod:`arrange_up.execution.replanning`).
-    validate
-        Rollouts that check a found plan on fresh initial states and noise
-        (:mod:`arrange_up.planning.validation`). Under the ``particles`` semantics, when some
-        fail, their initial states join the search's particles (at most ``particles`` of them
-        per round) and the search runs again, at most
-        :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while ``timeout``
-        leaves time; the plan returned is the one that did best. Under the other semantics the
-        one plan is checked and returned as it did. :attr:`PlanResult.validation` says how each
-        search did. ``None`` (default): twice ``particles``, at least 60, for the ``particles``
-        semantics and 60 for ``cbst`` (conformant plans), 0 (off) for ``deterministic`` (nominal
-        plans); 0 turns it off. A ``start`` belief (a posterior, not the problem's initial
-        uncertainty) takes no validation: a positive value with one raises ``ValueError``.
-    agenda
-        Search by the goal agenda first (:mod:`arrange_up.planning.agenda`): one part at a
-        time in an order taken from the goal's geometry, each from the belief the previous
-        part's plan reached; where it fails, the whole goal is searched (with the whole node
-        limit, in the time left). :attr:`PlanResult.agenda` says which found the plan. False:
-        the whole goal only. Each search, of a subgoal or of the whole goal, runs again
-        without the ordering filter where the filter left nothing to search.
+        replans from its posterior this way (:mod:`arrange_up.execution.replanning`). A start
+        belief (a posterior, not the problem's initial uncertainty) takes no validation: a
+        positive ``validate`` with one raises ``ValueError``.
+
+    Notes
+    -----
+    The search: by the goal agenda first (``search.agenda``, :mod:`arrange_up.planning.agenda`),
+    one part at a time from the belief the last one reached, then, where it fails, the whole
+    goal in the node limit and time left; :attr:`PlanResult.agenda` says which found the plan.
+    Its ``timeout`` covers the whole run, validation included: a plan found before it runs out
+    is returned with the validation rollouts that fitted.
+
+    The runner computes successors the search will evaluate next while it deals with the
+    current one (:mod:`arrange_up.planning.successors`); the plan and the statistics do not
+    depend on where they run. A semantics that simulates no pushes (``cbst``) always computes
+    them in this process and starts no pool or cluster (nor reaches the scheduler); for one
+    that does, :class:`~arrange_up.parallel.BackendUnavailableError` says that dask is missing
+    or the scheduler cannot be reached.
+
+    Validation: a found plan is checked on ``config.validate`` fresh rollouts
+    (:mod:`arrange_up.planning.validation`). Under the ``particles`` semantics, when some fail,
+    their initial states join the search's particles (at most ``particles`` of them per round)
+    and the search runs again, at most
+    :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while the timeout
+    leaves time; the plan returned is the one that did best. Under the other semantics the one
+    plan is checked and returned as it did. :attr:`PlanResult.validation` says how each search
+    did. The default (None) is twice ``particles``, at least 60, for the ``particles`` semantics
+    and 60 for ``cbst`` (conformant plans), 0 (off) for ``deterministic`` (nominal plans).
     """
-    check_validate(validate, start)
+    config = PlanConfig.of(config, **options)
+    check_validate(config.validate, start)
+    validate = config.validate
     if validate is None:
-        validate = default_validation(semantics, particles, start)
-    research = research_on_failure(semantics)
+        validate = default_validation(config.semantics, config.particles, start)
+    research = research_on_failure(config.semantics)
     # The search's runner checks its plans too; a semantics that starts no workers or cluster
     # for its search (cbst predicts in this process) starts none to check its plan.
-    runner = (
-        {"workers": workers, "backend": backend, "scheduler": scheduler}
-        if simulates_pushes(semantics)
-        else {"workers": 1, "backend": "local", "scheduler": None}
-    )
+    runner = config.runner if simulates_pushes(config.semantics) else SERIAL
+    timeout = config.search.timeout
     started = time.monotonic()
 
     def search(start: Any, particles: int, number: int = 1) -> PlanResult:
@@ -401,6 +346,7 @@ def plan(
         report = progress
         if progress is not None and number > 1:
             report = functools.partial(_numbered, progress, number)
+        sized = PlanConfig.of(config, particles=particles)
 
         def one(
             goal: ArrangementProblem,
@@ -411,28 +357,15 @@ def plan(
         ) -> PlanResult:
             return _searched(
                 goal,
-                semantics=semantics,
-                particles=particles,
-                seed=seed,
-                max_nodes=nodes,
+                PlanConfig.of(sized, max_nodes=nodes),
                 timeout=seconds,
-                heuristic=heuristic,
-                dominance=dominance,
-                weight=weight,
-                deferred=deferred,
-                workers=workers,
-                backend=backend,
-                scheduler=scheduler,
-                tie_break=tie_break,
-                variety=variety,
                 progress=tell,
                 should_stop=should_stop,
-                model=model,
                 start=start,
             )
 
-        limit = _node_limit(problem, max_nodes)
-        if agenda:
+        limit = config.search.node_limit(problem.planning.max_nodes)
+        if config.search.agenda:
             return plan_by_agenda(
                 problem, one, start=start, max_nodes=limit, timeout=left, progress=report
             )
@@ -449,6 +382,7 @@ def plan(
                 stopped_by.append("a stop request")
         return bool(stopped_by)
 
+    particles = config.particles
     result = search(start, particles)
     if not validate or not result.solved:
         return result
@@ -469,10 +403,10 @@ def plan(
             problem,
             result.actions,  # type: ignore[arg-type]  # set when solved
             rollouts=validate,
-            seed=seed,
+            seed=config.seed,
             round_=round_,
             should_stop=stop,
-            **runner,
+            **runner.as_options(),
         )
         rounds.append(
             ValidationRound(size, result.status, result.stats["expanded"], successes, run)
@@ -504,27 +438,24 @@ def _numbered(progress: ProgressCallback, number: int, stats: dict[str, Any]) ->
     progress({**stats, "search": number})
 
 
-def _node_limit(problem: ArrangementProblem, max_nodes: int | None) -> int:
-    """The node limit of a run: ``max_nodes``, else the problem's, else the default."""
-    return max_nodes if max_nodes is not None else (problem.planning.max_nodes or DEFAULT_MAX_NODES)
-
-
 def _searched(
-    problem: ArrangementProblem, *, max_nodes: int, timeout: float | None, **options: Any
+    problem: ArrangementProblem, config: PlanConfig, *, timeout: float | None, **options: Any
 ) -> PlanResult:
     """:func:`_search`, and where the ordering filter left nothing to search (the search ran
     out of beliefs having cut some as dead ends, the start perhaps), the search again without
     the filter in the nodes and time left: the filter is a heuristic, and ``exhausted`` must
     mean that the space was searched. The statistics count both searches."""
     started = time.monotonic()
-    first = _search(problem, max_nodes=max_nodes, timeout=timeout, **options)
+    first = _search(problem, config, timeout=timeout, **options)
     if first.status != SearchStatus.EXHAUSTED or not first.statistics.pruned_infinite:
         return first
+    max_nodes = config.search.node_limit(problem.planning.max_nodes)
     again = _search(
         problem,
-        max_nodes=max_nodes - first.statistics.expanded,
+        PlanConfig.of(
+            config, max_nodes=max_nodes - first.statistics.expanded, ordering_filter=False
+        ),
         timeout=None if timeout is None else max(0.0, timeout - (time.monotonic() - started)),
-        ordering_filter=False,
         **options,
     )
     return again.after([first], max_nodes)
@@ -532,58 +463,31 @@ def _searched(
 
 def _search(
     problem: ArrangementProblem,
+    config: PlanConfig,
     *,
-    semantics: str,
-    particles: int,
-    seed: int,
-    max_nodes: int | None,
     timeout: float | None,
-    heuristic: str,
-    dominance: bool,
-    weight: float,
-    deferred: bool,
-    workers: int,
-    backend: str,
-    scheduler: str | None,
-    tie_break: bool,
-    variety: bool,
     progress: ProgressCallback | None,
     should_stop: Callable[[], bool] | None,
-    model: str | Path | None,
     start: Any,
-    ordering_filter: bool = True,
 ) -> PlanResult:
-    """One best-first search of :func:`plan` (its arguments of the same names), unvalidated;
-    ``ordering_filter=False`` leaves the ordering filter out of the heuristic."""
+    """One best-first search of :func:`plan` under ``config`` (``timeout`` the seconds left of
+    the run), unvalidated."""
     started = time.monotonic()
-    limit = _node_limit(problem, max_nodes)
-    # bad backend options fail before the task is built, whether a runner is made or not
-    check_runner_options(backend, workers, scheduler)
-    task = BeliefTask.build(
-        problem,
-        semantics=semantics,
-        particles=particles,
-        seed=seed,
-        workers=1,  # the runner computes whole successors; no pool per transition
-        heuristic=heuristic,
-        dominance=dominance,
-        variety=variety,
-        model=model,
-        start=start,
-        ordering_filter=ordering_filter,
-    )
+    options = config.search
+    limit = options.node_limit(problem.planning.max_nodes)
+    task = BeliefTask.build(problem, config, start=start)
     # A learned prediction (CBST) costs less than shipping its job to a worker and back:
     # workers only slowed such a search down, so it runs in this process (same plan), and no
     # pool or cluster is started (nor a scheduler reached) for it.
     runner: Runner = SerialRunner()
     if task.semantics.simulates_pushes:
         try:
-            runner = get_runner(backend, workers, scheduler)
+            runner = config.runner.runner()
         except BaseException:
             task.close()
             raise
     index = task.dominance_index()
-    spec = WorkerSpec(problem, semantics, particles, seed, heuristic, model, ordering_filter)
+    spec = WorkerSpec(problem, config)
     evaluator = SuccessorEvaluator(task, runner, spec, index)
 
     def report(stats: SearchStats) -> None:
@@ -602,14 +506,14 @@ def _search(
                 evaluator.successors,
                 task.is_goal,
                 evaluator.heuristic,
-                weight=weight,
-                deferred=deferred,
+                weight=options.weight,
+                deferred=options.deferred,
                 dominance_index=index,
                 max_nodes=limit,
                 timeout=None
                 if timeout is None
                 else max(0.0, timeout - (time.monotonic() - started)),
-                tie_break_seed=seed if tie_break else None,
+                tie_break_seed=config.seed if options.tie_break else None,
                 progress=report,
                 should_stop=should_stop,
                 prefetch=evaluator.prefetch if evaluator.ahead else None,
@@ -625,15 +529,15 @@ def _search(
             "elapsed": time.monotonic() - started,
         },
         max_nodes=limit,
-        heuristic=heuristic,
-        dominance=dominance,
-        weight=weight,
+        heuristic=options.heuristic,
+        dominance=options.dominance,
+        weight=options.weight,
     )
     return PlanResult(
         status=result.status,
         actions=tuple(result.plan) if result.plan is not None else None,
         semantics=task.semantics.name,
-        seed=seed,
+        seed=config.seed,
         particles=task.semantics.particles,
         statistics=statistics,
         beliefs=tuple(result.states) if result.states is not None else None,

@@ -48,13 +48,13 @@ import threading
 from collections import Counter, deque
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from arrange_up.belief.states import IntervalDominanceIndex, ParticleBelief
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Push
 from arrange_up.parallel import Pending, Runner, SerialRunner, Session
+from arrange_up.planning.config import PlanConfig
 from arrange_up.planning.task import BeliefTask
 from arrange_up.search import DOMINATED, Edge
 from arrange_up.transitions.particles import ParticleSemantics
@@ -93,12 +93,7 @@ class WorkerSpec:
     the task is built on first use and kept with the unpickled spec)."""
 
     problem: ArrangementProblem
-    semantics: str
-    particles: int
-    seed: int
-    heuristic: str
-    model: str | Path | None = None
-    ordering_filter: bool = True
+    config: PlanConfig
     _task: BeliefTask | None = field(default=None, repr=False)
     _lock: Any = field(default=None, repr=False)
 
@@ -113,18 +108,10 @@ class WorkerSpec:
 
     def task(self) -> BeliefTask:
         if self._task is None:
-            self._task = BeliefTask.build(
-                self.problem,
-                semantics=self.semantics,
-                particles=self.particles,
-                seed=self.seed,
-                workers=1,
-                heuristic=self.heuristic,
-                dominance=False,
-                variety=False,
-                model=self.model,
-                ordering_filter=self.ordering_filter,
-            )
+            # a worker only resolves transitions and heuristic values: no dominance, and the
+            # pushes it is given are already varied
+            config = PlanConfig.of(self.config, dominance=False, variety=False)
+            self._task = BeliefTask.build(self.problem, config)
         return self._task
 
     def lock(self) -> Any:

@@ -14,7 +14,6 @@ import dataclasses
 import hashlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ from arrange_up.belief.states import IntervalDominanceIndex
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Push
 from arrange_up.planning.actions import ActionGenerator
+from arrange_up.planning.config import PlanConfig
 from arrange_up.planning.heuristics import make_heuristic
 from arrange_up.search import Edge
 from arrange_up.transitions import Semantics, make_semantics
@@ -69,29 +69,23 @@ class BeliefTask:
 
     @classmethod
     def build(
-        cls,
-        problem: ArrangementProblem,
-        *,
-        semantics: str,
-        particles: int,
-        seed: int,
-        workers: int,
-        heuristic: str,
-        dominance: bool,
-        variety: bool,
-        model: str | Path | None = None,
-        start: Any = None,
-        ordering_filter: bool = True,
+        cls, problem: ArrangementProblem, config: PlanConfig, *, start: Any = None
     ) -> BeliefTask:
-        """The task of :func:`~arrange_up.planning.planner.plan`'s arguments of the same names;
-        ``ordering_filter=False`` leaves the ordering filter out of the heuristic
-        (:func:`~arrange_up.planning.heuristics.make_heuristic`).
+        """The task of one search of ``problem`` under ``config`` from ``start`` (None: the
+        problem's initial belief). Successors are computed whole by the search's runner, so
+        the semantics starts no pool of its own.
 
         The semantics is instantiated first (it may start worker processes); it is closed
         again if building the rest fails.
         """
+        search = config.search
         model = make_semantics(
-            semantics, problem, particles=particles, seed=seed, workers=workers, model=model
+            config.semantics,
+            problem,
+            particles=config.particles,
+            seed=config.seed,
+            workers=1,  # the runner computes whole successors; no pool per transition
+            model=config.model,
         )
         try:
             compiled = compile_problem(problem)
@@ -106,12 +100,18 @@ class BeliefTask:
                 clearance_pushes=model.particles > 1,
             )
             estimate = make_heuristic(
-                heuristic, problem, goal, checker, generator, ordering_filter=ordering_filter
+                search.heuristic,
+                problem,
+                goal,
+                checker,
+                generator,
+                ordering_filter=search.ordering_filter,
             )
         except BaseException:
             model.close()
             raise
-        return cls(model, goal, generator, estimate, dominance, seed if variety else None, start)
+        variety_seed = config.seed if search.variety else None
+        return cls(model, goal, generator, estimate, search.dominance, variety_seed, start)
 
     def initial_belief(self) -> Any:
         """The belief the search starts from: :attr:`start` when given, else the semantics'

@@ -72,6 +72,7 @@ from unified_planning.plans import Plan
 from arrange_up.counts import check_count
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.planning import planner
+from arrange_up.planning.config import PlanConfig
 from arrange_up.planning.validation import check_validate
 from arrange_up.search import SearchStatus
 from arrange_up.transitions import available
@@ -128,13 +129,17 @@ class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
         OneshotPlannerMixin.__init__(self)
         _check_params(semantics, particles, seed, max_nodes, model, validate)
         check_parallel_params(ENGINE_NAME, workers, backend, scheduler)
-        self._semantics = semantics
-        self._particles = particles
-        self._seed = seed
-        self._max_nodes = max_nodes
-        self._model = model
-        self._validate = validate
-        self._parallel = {"workers": workers, "backend": backend, "scheduler": scheduler}
+        self._config = PlanConfig.of(
+            semantics=semantics,
+            particles=particles,
+            seed=seed,
+            max_nodes=max_nodes,
+            model=model,
+            validate=validate,
+            workers=workers,
+            backend=backend,
+            scheduler=scheduler,
+        )
 
     def _solve_with_params(
         self,
@@ -181,8 +186,8 @@ class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
             status = Status.INTERNAL_ERROR if arrangement.internal else Status.UNSUPPORTED_PROBLEM
             return result(status, logs=[LogMessage(LogLevel.ERROR, arrangement.message)])
 
-        if self._semantics == "cbst":
-            refusal = _model_refusal(arrangement, self._model)
+        if self._config.semantics == "cbst":
+            refusal = _model_refusal(arrangement, self._config.model)
             if refusal is not None:
                 return result(
                     Status.UNSUPPORTED_PROBLEM, logs=[LogMessage(LogLevel.ERROR, refusal)]
@@ -204,16 +209,10 @@ class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
         try:
             outcome = planner.plan(
                 arrangement,
-                semantics=self._semantics,
-                particles=self._particles,
-                seed=self._seed,
-                max_nodes=self._max_nodes,
+                self._config,
                 timeout=None if deadline is None else max(0.0, deadline - time.monotonic()),
                 progress=progress,
                 should_stop=out_of_time,
-                model=self._model,
-                validate=self._validate,
-                **self._parallel,
             )
         except Exception as error:  # the engine must answer, not raise
             return result(

@@ -10,6 +10,7 @@ from catalogue import tiny
 from arrange_up.belief.compiled import CompiledProblem, compile_problem
 from arrange_up.belief.states import AngleFrame
 from arrange_up.model.world import WorldState
+from arrange_up.planning.config import PlanConfig, SearchConfig
 from arrange_up.planning.task import BeliefTask
 
 
@@ -35,14 +36,7 @@ def test_its_members_are_those_the_problem_derives():
 def test_the_planners_semantics_and_generator_share_one_checker():
     problem = tiny("two-blocks-row")
     task = BeliefTask.build(
-        problem,
-        semantics="particles",
-        particles=2,
-        seed=0,
-        workers=1,
-        heuristic="manhattan",
-        dominance=True,
-        variety=False,
+        problem, PlanConfig(particles=2, seed=0, search=SearchConfig(heuristic="manhattan"))
     )
     try:
         compiled = compile_problem(problem)

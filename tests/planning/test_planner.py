@@ -15,6 +15,7 @@ from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.world import Place, Push, nominal_initial_state, nominal_noise
 from arrange_up.physics.simulation import simulate
+from arrange_up.planning.config import PlanConfig
 from arrange_up.planning.planner import (
     PlanStatistics,
     SearchSnapshot,
@@ -128,16 +129,7 @@ def test_status_and_statistics_are_typed_and_serialise_as_before(blocks2):
 
 
 def test_the_task_answers_what_the_search_asks_and_closes_its_semantics(blocks2):
-    task = BeliefTask.build(
-        blocks2,
-        semantics="particles",
-        particles=3,
-        seed=0,
-        workers=1,
-        heuristic="inadmissible",
-        dominance=True,
-        variety=False,
-    )
+    task = BeliefTask.build(blocks2, PlanConfig(particles=3, seed=0))
     try:
         start = task.initial_belief()
         assert not task.is_goal(start) and task.heuristic(start) > 0
