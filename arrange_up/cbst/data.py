@@ -96,7 +96,7 @@ __all__ = [
     "DATA_FORMAT",
     "Dataset",
     "GenerationSettings",
-    "ProgressCallback",
+    "TrainingProgress",
     "SHIPPED_WALL_PUSH",
     "WALL_PUSHES",
     "generate_dataset",
@@ -106,7 +106,7 @@ __all__ = [
 
 DATA_FORMAT = "arrange-up-cbst-data/1"
 
-ProgressCallback = Callable[[str, int, int], None]
+TrainingProgress = Callable[[str, int, int], None]
 """``progress(stage, done, total)``."""
 
 #: Paddle angle that pushes toward +x (the paddle pushes along its frame's +y).
@@ -480,7 +480,7 @@ def generate_dataset(
     scheduler: str | None = None,
     chunksize: int | None = None,
     settings: GenerationSettings = DEFAULT_GENERATION,
-    progress: ProgressCallback | None = None,
+    progress: TrainingProgress | None = None,
 ) -> dict[str, Any]:
     """Make sure ``path`` holds examples ``0 .. examples-1`` of the data set of ``seed`` with
     ``rollouts`` rollouts each, computing and appending the missing ones.

@@ -88,7 +88,7 @@ DEFAULT_GRID: dict[str, list[Any]] = {
     "residual": [None, DY_RESIDUAL],
 }
 
-ProgressCallback = Callable[[str, int, int], None]
+TrainingProgress = Callable[[str, int, int], None]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -289,7 +289,7 @@ def train_cbst(
     test_data_path: str | Path | None = None,
     param_grid: Mapping[str, list[Any]] | None = None,
     n_estimators: int = 100,
-    progress: ProgressCallback | None = None,
+    progress: TrainingProgress | None = None,
 ) -> dict[str, Any]:
     """Generate (or resume) the training data and a fresh test set, tune the model by
     cross-validation, score it, and save ``NAME.npz`` + ``NAME.json`` into ``output_dir``.
@@ -444,7 +444,7 @@ def train_cbst(
     return json.loads((out / f"{name}.json").read_text(encoding="utf-8"))
 
 
-def _relabel(progress: ProgressCallback, stage: str, _stage: str, done: int, total: int) -> None:
+def _relabel(progress: TrainingProgress, stage: str, _stage: str, done: int, total: int) -> None:
     progress(stage, done, total)
 
 
@@ -459,7 +459,7 @@ def rescore_model(
     backend: str = "local",
     scheduler: str | None = None,
     write: bool = False,
-    progress: ProgressCallback | None = None,
+    progress: TrainingProgress | None = None,
 ) -> dict[str, Any]:
     """The card ``scores`` of a saved model, measured again: its training data regenerated
     (or resumed) from the card's examples, rollouts, seed and settings into ``data_path``

@@ -43,10 +43,11 @@ from shapely.geometry.base import BaseGeometry
 from arrange_up.geometry.boxes import wall_boxes
 from arrange_up.geometry.shapes import footprint
 from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind
+from arrange_up.planning.config import ProgressCallback
 from arrange_up.search import SearchStatus
 
 if TYPE_CHECKING:
-    from arrange_up.planning.planner import PlanResult, ProgressCallback
+    from arrange_up.planning.planner import PlanResult
 
 __all__ = [
     "CONTACT_GAP",
@@ -77,7 +78,7 @@ _FINAL = frozenset({SearchStatus.TIMEOUT, SearchStatus.CANCELLED, SearchStatus.U
 #: :class:`~arrange_up.planning.planner.PlanResult`; ``start`` None is the problem's initial
 #: belief, ``timeout`` None no time limit.
 SubSearch = Callable[
-    [ArrangementProblem, Any, int, "float | None", "ProgressCallback | None"], "PlanResult"
+    [ArrangementProblem, Any, int, "float | None", ProgressCallback | None], "PlanResult"
 ]
 
 

@@ -14,6 +14,7 @@ names :func:`~arrange_up.planning.planner.plan` also accepts as keywords.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,6 +24,10 @@ from arrange_up.parallel import RunnerConfig
 from arrange_up.planning.heuristics import check_heuristic
 from arrange_up.planning.validation import check_validate
 from arrange_up.transitions import available
+
+#: Receives a planning run's statistics (``SearchSnapshot.to_json()`` of
+#: :mod:`arrange_up.planning.planner`) every :data:`arrange_up.search.PROGRESS_INTERVAL` seconds.
+ProgressCallback = Callable[[dict[str, Any]], None]
 
 DEFAULT_MAX_NODES = 5000
 """The thesis's node limit (§3.3)."""
@@ -37,8 +42,8 @@ the thesis's A*."""
 class SearchConfig:
     """How the belief space is searched.
 
-    Attributes
-    ----------
+    Fields:
+
     weight
         ``f = g + weight * h``; 1 is A*, the default 2 weighted A* (see :data:`DEFAULT_WEIGHT`).
     heuristic
@@ -109,8 +114,8 @@ class SearchConfig:
 class PlanConfig:
     """Everything a planning run is configured by (see :func:`~arrange_up.planning.planner.plan`).
 
-    Attributes
-    ----------
+    Fields:
+
     semantics
         The belief transition, by name (see :mod:`arrange_up.transitions`).
     particles

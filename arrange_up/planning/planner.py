@@ -28,6 +28,7 @@ from arrange_up.planning.config import (
     DEFAULT_MAX_NODES,
     DEFAULT_WEIGHT,
     PlanConfig,
+    ProgressCallback,
     SearchConfig,
 )
 from arrange_up.planning.fitting import too_large, unfit_parts
@@ -255,10 +256,6 @@ class PlanResult:
         """``statistics.to_json()``: the dict plan files and ``--json`` output store, kept as
         the form callers index (``result.stats["expanded"]``)."""
         return self.statistics.to_json()
-
-
-#: Receives ``SearchSnapshot.to_json()`` every :data:`arrange_up.search.PROGRESS_INTERVAL` seconds.
-ProgressCallback = Callable[[dict[str, Any]], None]
 
 
 #: Open entries the workers look ahead into for pushes to simulate: the entries that follow
