@@ -23,7 +23,7 @@ import datetime as _dt
 import json
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
@@ -37,6 +37,7 @@ from arrange_up.cbst.data import (
     DEFAULT_GENERATION,
     Dataset,
     GenerationSettings,
+    TrainingProgress,
     generate_dataset,
     load_dataset,
 )
@@ -87,8 +88,6 @@ DEFAULT_GRID: dict[str, list[Any]] = {
     "min_samples_leaf": [12, 24, 48],
     "residual": [None, DY_RESIDUAL],
 }
-
-TrainingProgress = Callable[[str, int, int], None]
 
 
 # ----------------------------------------------------------------------------------------------
