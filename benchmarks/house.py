@@ -53,7 +53,7 @@ The walk of one value through the calls
       objects' attributes are not followed (``context.problem`` read from a record passed on).
       ``reached`` is the number of functions visited, the start included.
     - A *climb* is a stop whose callee lies in a room earlier in the pipeline than the caller's
-      (``ROOMS``, the floors of docs/design/README.md, which ``tests/test_house.py`` enforces:
+      (``ROOMS``, the floors of docs/design/README.md, enforced by ``tests/test_house.py``:
       the package's rooms in the order a problem flows through them; the design's list of rooms
       names transitions before cbst and planning before evaluation, but the imports run the
       other way, so the floors decide). Calls within a room are never climbs; a room can only

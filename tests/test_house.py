@@ -1,42 +1,28 @@
 """The house rule: each room of the package imports only rooms below it.
 
-A room is a sub-package of ``arrange_up`` (or a top-level module such as ``search``); ``LAYERS``
-lists them bottom-up, rooms on one line being peers that must not import each other. Every import
-of the package's own modules counts, at module level or inside a function. The package's
-``__init__`` and ``__main__`` sit above every room; the package root itself may be imported
-anywhere for its ``__version__``.
+A room is a sub-package of ``arrange_up`` (or a top-level module such as ``search``);
+``benchmarks/house.py``'s ``ROOMS`` lists them bottom-up, rooms on one line being peers that must
+not import each other. Every import of the package's own modules counts, at module level or
+inside a function. The package's ``__init__`` and ``__main__`` sit above every room; the package
+root itself may be imported anywhere for its ``__version__``.
 """
 
 from __future__ import annotations
 
 import ast
+import sys
 from pathlib import Path
 
 import pytest
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from house import ROOMS  # noqa: E402  (the room order is written once, in benchmarks/house.py)
+
 PACKAGE_DIR = Path(__file__).resolve().parents[1] / "arrange_up"
 
-LAYERS: tuple[tuple[str, ...], ...] = (
-    ("counts",),
-    ("search", "parallel", "model"),
-    ("geometry",),
-    ("io",),
-    ("physics",),
-    ("belief",),
-    ("cbst",),
-    ("transitions",),
-    ("evaluation",),
-    ("planning",),
-    ("execution",),
-    ("repair",),
-    ("up",),
-    ("figures",),
-    ("experiments",),
-    ("cli",),
-)
 TOP = ("__init__", "__main__")
 ROOT_METADATA = ("arrange_up", "arrange_up.__version__")
-LEVEL = {room: level for level, rooms in enumerate(LAYERS) for room in rooms}
+LEVEL = {room: level for level, rooms in enumerate(ROOMS) for room in rooms}
 
 
 def _room(module: str) -> str:

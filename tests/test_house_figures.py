@@ -9,9 +9,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-from house import ROOMS, Index, measure, walk  # noqa: E402
-
-from tests.test_house import LAYERS  # noqa: E402
+from house import Index, measure, walk  # noqa: E402
 
 PACKAGE = {
     "__init__.py": "",
@@ -114,7 +112,3 @@ def test_the_sizes(root: Path) -> None:
     assert figures["most_parameters"] == {"arrange_up.planning.task:_helper": 11}
     assert figures["type_ignore_comments"] == 1
     assert figures["any_in_annotations"] == 2
-
-
-def test_the_room_order_is_the_house_rule() -> None:
-    assert ROOMS == LAYERS
