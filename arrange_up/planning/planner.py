@@ -41,6 +41,7 @@ from arrange_up.planning.validation import (
     check_validate,
     choose_round,
     default_validation,
+    research_budget,
     research_on_failure,
     validate_plan,
 )
@@ -321,7 +322,9 @@ def plan(
     their initial states join the search's particles (at most ``particles`` of them per round)
     and the search runs again, at most
     :data:`~arrange_up.planning.validation.VALIDATION_REPLANS` more times, while the timeout
-    leaves time; the plan returned is the one that did best. Under the other semantics the one
+    leaves time, each within
+    :func:`~arrange_up.planning.validation.research_budget` of the first search's nodes; the
+    plan returned is the one that did best. Under the other semantics the one
     plan is checked and returned as it did. :attr:`PlanResult.validation` says how each search
     did. The default (None) is twice ``particles``, at least 60, for the ``particles`` semantics
     and 60 for ``cbst`` (conformant plans), 0 (off) for ``deterministic`` (nominal plans).
@@ -338,7 +341,9 @@ def plan(
     timeout = config.search.timeout
     started = time.monotonic()
 
-    def search(start: Any, particles: int, number: int = 1) -> PlanResult:
+    def search(start: Any, particles: int, number: int = 1, first: int = 0) -> PlanResult:
+        """Search ``number`` of the run, from ``start`` with ``particles``; after the first,
+        within :func:`research_budget` of the ``first`` search's expanded nodes."""
         left = None if timeout is None else max(0.0, timeout - (time.monotonic() - started))
         report = progress
         if progress is not None and number > 1:
@@ -362,6 +367,8 @@ def plan(
             )
 
         limit = config.search.node_limit(problem.planning.max_nodes)
+        if number > 1:
+            limit = research_budget(first, limit)
         if config.search.agenda:
             return plan_by_agenda(
                 problem, one, start=start, max_nodes=limit, timeout=left, progress=report
@@ -392,7 +399,7 @@ def plan(
             belief = found[-1].beliefs[0]  # type: ignore[index]  # a solved search's start
             belief = ParticleBelief(belief.particles + failed[:particles])
             size = len(belief.poses)
-            result = search(belief, size, round_ + 1)
+            result = search(belief, size, round_ + 1, rounds[0].expanded)
         if not result.solved:
             rounds.append(ValidationRound(size, result.status, result.stats["expanded"], None))
             break

@@ -53,11 +53,26 @@ __all__ = [
     "default_validation_rollouts",
     "validate_plan",
     "validation_seed",
+    "research_budget",
 ]
 
 #: Searches after the first that validation may start. Measured on the fresh problems
 #: (docs/design/planning.md, "Validated plans"): the rounds that helped needed one or two.
 VALIDATION_REPLANS = 3
+
+#: A search after the first may expand at most this many times the nodes the first expanded
+#: (at least :data:`MIN_RESEARCH_NODES`, at most the run's node limit): it refines a plan in
+#: hand with more particles, so it must not cost what finding a first plan from nothing may.
+RESEARCH_NODE_FACTOR = 4
+#: The fewest nodes a search after the first may expand.
+MIN_RESEARCH_NODES = 200
+
+
+def research_budget(first_expanded: int, node_limit: int) -> int:
+    """The node limit of a search after the first, whose first search expanded
+    ``first_expanded`` nodes in a run limited to ``node_limit``."""
+    return min(node_limit, max(MIN_RESEARCH_NODES, RESEARCH_NODE_FACTOR * first_expanded))
+
 
 #: ``SeedSequence`` key of the validation stream, apart from the planner's other draws.
 _VALIDATION_KEY = 0x5A11D

@@ -4,18 +4,20 @@ their preconditions, the planning hints that shape them and the unclipped-pushes
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 from catalogue import servo, tiny, variant, with_planning
 
 from arrange_up.belief.states import IntervalBelief, ObjectInterval
 from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.io.yaml_problem import load_problem_text
+from arrange_up.io.yaml_problem import load_problem, load_problem_text
 from arrange_up.model.world import Pick, Place, Push
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.planning.generators.common import MIN_PUSH
 from arrange_up.planning.obstacles import GAP
 
+FRESH = Path(__file__).parents[1] / "problems" / "fresh"
 NONE = (0.0, 0.0, 0.0)
 SMALL = (0.1, 0.1, 0.05)  # a belief interval's half-widths after a push or two
 #: Paddle angle that pushes along each direction (the paddle pushes along its own +y).
@@ -107,6 +109,33 @@ def test_default_place_grid_steps_by_the_shadow_growth_plus_a_tenth():
     assert place.obj == "A" and place.pose == pytest.approx((4.5 - step, 0.5 + step, 0.0))
 
 
+def test_a_part_with_no_clear_place_on_the_grid_is_offered_the_nearest_clear_ring():
+    # A cube into a bracket with 0.15 in of clearance a side, less than the place uncertainty:
+    # no place of the 3 x 3 grid about the goal keeps the shadow clear of the bracket.
+    problem = load_problem(FRESH / "bracket-clearance.yaml")
+    gen = generator(problem)
+    step = max(abs(dx) for dx, _ in gen.place_generator.offsets["A"])
+    goal = problem.goal.target("A")
+    places = gen.places(IntervalBelief(()))
+    assert places
+    rings = {
+        round(max(abs(p.pose[0] - goal[0]), abs(p.pose[1] - goal[1])) / step, 6) for p in places
+    }
+    (ring,) = rings  # every place from one ring: the first with a clear place
+    assert ring >= 2 and ring == int(ring)
+    half = problem.uncertainty.place
+    for k in range(1, int(ring)):  # the nearer rings have none
+        lattice = [(i, j) for i in range(-k, k + 1) for j in range(-k, k + 1)]
+        for dx, dy in [(i * step, j * step) for i, j in lattice if max(abs(i), abs(j)) == k]:
+            pose = (goal[0] + dx, goal[1] + dy, goal[2])
+            assert not gen.place_generator._place_ok("A", pose, half, [], [])
+    # Offsets the problem gives replace the grid and its rings.
+    hinted = load_problem_text(
+        (FRESH / "bracket-clearance.yaml").read_text() + "planning: {place_offsets: [[0, 0]]}\n"
+    )
+    assert generator(hinted).places(IntervalBelief(())) == []
+
+
 def test_place_hints_replace_the_grid_and_add_angles():
     hints = "{place_offsets: [[-1, 1], [-2, 1], [0, 0]], place_angles: [0, 45]}"
     problem = with_planning("one-block", hints)
@@ -135,10 +164,16 @@ def test_places_skip_parts_on_the_table_and_honour_only():
 def test_place_poses_ignore_the_objects_on_the_table_but_not_the_walls():
     problem = tiny("two-blocks-row")
     gen = generator(problem)
-    # A sits on B's target: no place of B is clear of it, yet B's place poses (the half of the
-    # precondition about the table, walls and obstacles) are all still there.
+    # A sits on B's target: no place of B's grid is clear of it (B's places come from a ring
+    # farther out), yet B's place poses (the half of the precondition about the table, walls
+    # and obstacles) are all still there.
     blocking = belief(A=((8.5, 0.9, 0.0), problem.uncertainty.place))
-    assert gen.places(blocking, only="B") == []
+    step = max(abs(dx) for dx, _ in gen.place_generator.offsets["B"])
+    target = problem.goal.target("B")
+    far = gen.places(blocking, only="B")
+    assert far and all(
+        max(abs(p.pose[0] - target[0]), abs(p.pose[1] - target[1])) > step + 1e-9 for p in far
+    )
     poses = gen.place_poses(blocking, "B")
     assert poses and poses == gen.place_poses(IntervalBelief(()), "B")
     for pose in poses:

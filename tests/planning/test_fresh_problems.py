@@ -97,3 +97,12 @@ def test_a_cube_is_pushed_into_the_nook_of_an_ell_squared_in_its_corner():
     assert place.pose[0] > goal[0] and place.pose[1] > goal[1]  # beside the nook, not in it
     final = result.beliefs[-1]
     assert GoalTest(problem).satisfied_array(final.poses, final.names())
+
+
+def test_a_cube_into_a_bracket_tighter_than_the_place_uncertainty_is_placed_out_and_pushed_in():
+    problem = load_problem(FRESH / "bracket-clearance.yaml")
+    result = arrange_up.plan(problem, particles=10, workers=1, validate=0)
+    assert result.solved, result.reason
+    assert isinstance(result.actions[0], Place) and isinstance(result.actions[-1], Push)
+    final = result.beliefs[-1]
+    assert GoalTest(problem).satisfied_array(final.poses, final.names())

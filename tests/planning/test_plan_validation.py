@@ -22,6 +22,7 @@ from arrange_up.planning.validation import (
     VALIDATION_REPLANS,
     ValidationRound,
     choose_round,
+    research_budget,
     validation_seed,
 )
 
@@ -80,6 +81,24 @@ def test_a_replan_without_a_plan_is_recorded_and_the_last_plan_found_returned(na
     assert found.successes < 10 and result.validation.chosen == 0
     assert (replan.particles, replan.status, replan.successes) == (4, "node-limit", None)
     assert result.actions == first.actions
+
+
+def test_a_search_after_the_first_is_limited_to_a_few_times_its_nodes() -> None:
+    assert research_budget(10, 5000) == 200  # the floor
+    assert research_budget(100, 5000) == 400  # four times the first search's nodes
+    assert research_budget(3000, 5000) == 5000  # never beyond the run's limit
+    assert research_budget(10, 50) == 50
+
+
+def test_the_searches_validation_starts_stay_within_their_budget(narrow, monkeypatch) -> None:
+    # Unlimited, the second search expands 6 nodes where the first expanded 2; held to the
+    # first's count, it stops at its limit and the first plan is returned.
+    monkeypatch.setattr(validation_module, "RESEARCH_NODE_FACTOR", 1)
+    monkeypatch.setattr(validation_module, "MIN_RESEARCH_NODES", 1)
+    result = plan(narrow, particles=2, seed=0, workers=1, validate=10)
+    first, second = result.validation.rounds
+    assert (first.expanded, second.expanded, second.status) == (2, 2, "node-limit")
+    assert result.validation.chosen == 0
 
 
 def test_a_rollout_start_is_the_first_state_of_its_rollout(narrow) -> None:

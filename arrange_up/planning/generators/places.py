@@ -8,6 +8,16 @@ hold next to walls and neighbours, and no more, since every extra inch must be p
 pushing accrues uncertainty. The angle is the target's (``planning.place_angles`` adds
 alternatives).
 
+Where no offset of the grid is clear at any target (a part whose goal is pressed against a
+part already built, whose shadow has grown with its pushes, or a clearance fit narrower than
+the place uncertainty), the places are sought on *rings* farther out, one ring at a time, up to
+the first with a clear place (:func:`rings`): ring k holds the offsets k grid steps from the
+target, out to the table's size. From such a place a push brings the part in. Only then, so
+that parts with a clear place nearby keep the shortest pushes. A relative goal's parts get no
+rings: a part must end beside its reference, which may move, and where no place beside it is
+clear the reference is moved first (the reference ladder,
+:mod:`~arrange_up.planning.generators.distances`).
+
 The precondition is tested on belief shadows (:mod:`arrange_up.geometry.collision`): the
 placed part's shadow (target +- place uncertainty) must lie on the table and touch no shadow of
 an object on the table, no wall and no obstacle.
@@ -15,6 +25,7 @@ an object on the table, no wall and no obstacle.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterator
 
 from arrange_up.belief.states import IntervalBelief
@@ -23,6 +34,36 @@ from arrange_up.model.problem import ArrangementProblem, ObjectSpec, Pose
 from arrange_up.model.world import Place
 from arrange_up.planning.generators.common import clean_pose
 from arrange_up.planning.generators.targets import GoalTargets
+
+#: The rings (in steps of the grid) tried at every point of the lattice; farther rings try the
+#: grid's eight directions only, so that a part with no clear place anywhere costs few tests.
+FULL_RINGS = 3
+
+
+@functools.lru_cache(maxsize=256)
+def rings(
+    grid: tuple[tuple[float, float], ...], reach: float
+) -> tuple[tuple[tuple[float, float], ...], ...]:
+    """The rings about a place grid (the module docstring): ring k, for k = 2, 3, ... while k
+    of the grid's steps stay within ``reach``, is the lattice of the grid's step at k steps
+    from the target (Chebyshev distance), every point of it up to :data:`FULL_RINGS`, the
+    grid's eight directions beyond; nearest first, ties in the grid's order (up before down,
+    left before right)."""
+    step = max(max(abs(dx), abs(dy)) for dx, dy in grid)
+    found = []
+    for k in range(2, int(reach / step) + 1):
+        if k <= FULL_RINGS:
+            points = [
+                (i, j)
+                for i in range(-k, k + 1)
+                for j in range(-k, k + 1)
+                if max(abs(i), abs(j)) == k
+            ]
+        else:
+            points = [(i * k, j * k) for i in (-1, 0, 1) for j in (-1, 0, 1) if i or j]
+        points.sort(key=lambda p: (p[0] ** 2 + p[1] ** 2, -p[1], p[0]))
+        found.append(tuple((round(i * step, 6), round(j * step, 6)) for i, j in points))
+    return tuple(found)
 
 
 class PlaceGenerator:
@@ -42,6 +83,13 @@ class PlaceGenerator:
             spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
             for spec in problem.parts
         }
+        #: Part name -> the offsets of each ring (none for a relative goal, and none where the
+        #: problem gives ``planning.place_offsets``: those replace the grid whole).
+        ringless = bool(hints.place_offsets) or problem.goal.is_relative
+        self.rings = {
+            spec.name: () if ringless else rings(self.offsets[spec.name], max(problem.table.size))
+            for spec in problem.parts
+        }
 
     def _grid(self, spec: ObjectSpec) -> tuple[tuple[float, float], ...]:
         nominal = self.checker.shadow_box(spec.name, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
@@ -58,13 +106,17 @@ class PlaceGenerator:
         for spec in self.problem.parts:
             if spec.name in belief or (only is not None and spec.name != only):
                 continue
-            for target in self.targets.place_targets(spec.name, belief):
+            targets = self.targets.place_targets(spec.name, belief)
+            for offsets in (self.offsets[spec.name], *self.rings[spec.name]):
                 found = len(actions)
-                for pose in self._place_grid(spec.name, target):
-                    if boxes is None:
-                        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
-                    if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
-                        actions.append(Place(spec.name, clean_pose(pose)))
+                for target in targets:
+                    for pose in self._place_grid(target, offsets):
+                        if boxes is None:
+                            boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+                        if self._place_ok(spec.name, pose, self.place_unc, on_table, boxes):
+                            actions.append(Place(spec.name, clean_pose(pose)))
+                    if len(actions) > found:
+                        break
                 if len(actions) > found:
                     break
         return actions
@@ -76,7 +128,7 @@ class PlaceGenerator:
         for target in self.targets.place_targets(name, belief):
             poses = [
                 pose
-                for pose in self._place_grid(name, target)
+                for pose in self._place_grid(target, self.offsets[name])
                 if self.checker.shadow_inside_table(name, pose, self.place_unc)
                 and not self.checker.shadow_hits_fixed(name, pose, self.place_unc)
             ]
@@ -84,11 +136,11 @@ class PlaceGenerator:
                 return poses
         return []
 
-    def _place_grid(self, name: str, target: Pose) -> Iterator[Pose]:
-        """The place poses of ``name`` about ``target``: each of its grid offsets, at each of
+    def _place_grid(self, target: Pose, offsets: tuple[tuple[float, float], ...]) -> Iterator[Pose]:
+        """The place poses about ``target``: each of ``offsets``, at each of
         :meth:`_place_angles`, in that order."""
         angles = self._place_angles(target)
-        for dx, dy in self.offsets[name]:
+        for dx, dy in offsets:
             for theta in angles:
                 yield (target[0] + dx, target[1] + dy, theta)
 
