@@ -60,6 +60,7 @@ The message (:attr:`Unfit.why`) names the part, its size, the table's and the go
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -105,7 +106,6 @@ def too_large(problem: ArrangementProblem) -> tuple[str, ...]:
 def unfit_parts(problem: ArrangementProblem) -> tuple[Unfit, ...]:
     """:func:`too_large` with the reason of each part (:attr:`Unfit.why`)."""
     goal = problem.goal
-    width, depth = problem.table.size
     closed = set(WALL_EDGES) <= set(problem.table.walls)
     names = list(goal.parts)
     if goal.reference is not None and goal.reference not in names:
@@ -115,33 +115,56 @@ def unfit_parts(problem: ArrangementProblem) -> tuple[Unfit, ...]:
         shape = problem.object(name).shape
         if shape is None:
             continue
-        vertices = np.array(list(shape.vertices()), dtype=float).reshape(-1, 2)
-        if len(vertices) == 0:
-            continue
-        # Fact 1: fits the table at no angle at all.
-        if _ruled_out(vertices, [(0.0, TWO_PI)], (width, depth), None, START_SLACK):
-            found.append(Unfit(name, _why(problem, name, shape, None, False)))
-            continue
-        if not closed or goal.is_relative:
-            # A relative goal allows every angle and position: fact 2 adds nothing to fact 1
-            # but the slack, so it is not tried.
-            continue
-        target = goal.target(name)
-        intervals = _allowed_angles(target[2], goal.tolerance[2], shape)
-        if intervals is None:
-            intervals = [(0.0, TWO_PI)]
-        # Fact 2: the walls keep the footprint inside the table at the goal's angles ...
-        if _ruled_out(vertices, intervals, (width, depth), None, WALL_SLACK):
-            found.append(Unfit(name, _why(problem, name, shape, target, False)))
-            continue
-        # ... and positions.
-        boxes = tuple(
-            (target[i] - goal.tolerance[i] - GOAL_EPS, target[i] + goal.tolerance[i] + GOAL_EPS)
-            for i in (0, 1)
+        target = None if goal.is_relative else goal.target(name)
+        fact = _unfit_fact(
+            problem.table.size, closed and not goal.is_relative, shape, target, goal.tolerance
         )
-        if _ruled_out(vertices, intervals, (width, depth), boxes, WALL_SLACK):
-            found.append(Unfit(name, _why(problem, name, shape, target, True)))
+        if fact is not None:
+            found.append(
+                Unfit(
+                    name,
+                    _why(problem, name, shape, None if fact == 1 else target, fact == 3),
+                )
+            )
     return tuple(found)
+
+
+@functools.lru_cache(maxsize=4096)
+def _unfit_fact(
+    table: tuple[float, float],
+    walled: bool,
+    shape: Shape,
+    target: tuple[float, float, float] | None,
+    tolerance: tuple[float, ...],
+) -> int | None:
+    """Which fact rules a part of ``shape`` out (1: the table at any angle; 2: inside the
+    walls at the goal's angles; 3: and positions), None when none does. ``walled``: the table
+    is closed by walls and the goal absolute (``target`` set), so facts 2 and 3 apply.
+    Remembered: the goal agenda asks again for every subgoal, and the answer depends on these
+    values only."""
+    vertices = np.array(list(shape.vertices()), dtype=float).reshape(-1, 2)
+    if len(vertices) == 0:
+        return None
+    # Fact 1: fits the table at no angle at all.
+    if _ruled_out(vertices, [(0.0, TWO_PI)], table, None, START_SLACK):
+        return 1
+    if not walled or target is None:
+        # A relative goal allows every angle and position: fact 2 adds nothing to fact 1
+        # but the slack, so it is not tried.
+        return None
+    intervals = _allowed_angles(target[2], tolerance[2], shape)
+    if intervals is None:
+        intervals = [(0.0, TWO_PI)]
+    # Fact 2: the walls keep the footprint inside the table at the goal's angles ...
+    if _ruled_out(vertices, intervals, table, None, WALL_SLACK):
+        return 2
+    # ... and positions.
+    boxes = tuple(
+        (target[i] - tolerance[i] - GOAL_EPS, target[i] + tolerance[i] + GOAL_EPS) for i in (0, 1)
+    )
+    if _ruled_out(vertices, intervals, table, boxes, WALL_SLACK):
+        return 3
+    return None
 
 
 def _allowed_angles(

@@ -54,6 +54,12 @@ Heuristic = Callable[[ParticleBelief], float]
 #: Answers "which place candidates of that part does this part's belief block for good" the
 #: ordering filter remembers.
 BLOCKING_CACHE = 200_000
+#: Pairs of goal parts whose blocking tables (the ordering filter's ``_pair_blocking``) are kept
+#: across searches: the goal agenda searches the same problem with its goal restricted to more
+#: and more parts, and a pair's table depends only on the world and the two parts' targets, so
+#: each pair is computed once per run instead of once per subgoal.
+PAIR_MEMO = 100_000
+_PAIR_MEMO: dict[tuple, tuple | None] = {}
 
 
 def check_heuristic(name: str) -> None:
@@ -193,6 +199,13 @@ class _OrderingFilter:
         self._goal_overlaps: dict[tuple[str, int, str], bool] = {}
         self._blocking: dict[tuple, frozenset[int]] = {}
         self._pairs_blocking = None
+        #: What a pair's blocking table depends on besides the pair and its targets.
+        self._world = (
+            problem.table,
+            problem.objects,
+            problem.uncertainty.place,
+            problem.planning,
+        )
         if goal.reference is not None:
             return
         boxes = {
@@ -317,10 +330,22 @@ class _OrderingFilter:
         table = {}
         for i, p in enumerate(self.goal_parts):
             for q in self.goal_parts[i + 1 :]:
-                after_p = [[blocked(p, pa, q, pb) for pb in poses[q]] for pa in poses[p]]
-                after_q = [[blocked(q, pb, p, pa) for pa in poses[p]] for pb in poses[q]]
-                if any(any(row) for row in after_p) or any(any(row) for row in after_q):
-                    table[(p, q)] = (after_p, after_q)
+                key = (self._world, p, self.targets[p], q, self.targets[q])
+                if key in _PAIR_MEMO:
+                    entry = _PAIR_MEMO[key]
+                else:
+                    after_p = [[blocked(p, pa, q, pb) for pb in poses[q]] for pa in poses[p]]
+                    after_q = [[blocked(q, pb, p, pa) for pa in poses[p]] for pb in poses[q]]
+                    entry = (
+                        (after_p, after_q)
+                        if any(any(row) for row in after_p) or any(any(row) for row in after_q)
+                        else None
+                    )
+                    if len(_PAIR_MEMO) >= PAIR_MEMO:
+                        _PAIR_MEMO.pop(next(iter(_PAIR_MEMO)))
+                    _PAIR_MEMO[key] = entry
+                if entry is not None:
+                    table[(p, q)] = entry
         self._pairs_blocking = table
         return table
 
