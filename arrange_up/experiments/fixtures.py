@@ -211,7 +211,7 @@ def fixture_experiment(
             actions,
             rollouts=rollouts,
             seed=seed,
-            **runner.as_options(),
+            runner=runner,
         )
         say(f"{what}: {result.successes}/{result.trials} rollouts reached the goal")
         return {

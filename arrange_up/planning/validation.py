@@ -255,7 +255,7 @@ def validate_plan(
         actions,
         rollouts=rollouts,
         seed=vseed,
-        **runner.as_options(),
+        runner=runner,
         keep_records=True,
         should_stop=should_stop,
     )
