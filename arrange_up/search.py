@@ -80,6 +80,7 @@ __all__ = [
     "DOMINATED",
     "PROGRESS_INTERVAL",
     "Edge",
+    "SearchOptions",
     "SearchResult",
     "SearchStats",
     "SearchStatus",
@@ -308,43 +309,28 @@ class _Search:
         successors: Callable[[Any], Iterable[Edge[Any, Any]]],
         is_goal: Callable[[Any], bool],
         heuristic: Callable[[Any], float],
-        *,
-        weight: float,
-        greedy: bool,
-        deferred: bool,
-        dominates: Callable[[Any, Any], bool] | None,
-        dominance_key: Callable[[Any], Hashable] | None,
-        dominance_ignores_g: bool,
-        dominance_index: DominanceIndex | None,
-        reopen: bool,
-        max_nodes: int | None,
-        timeout: float | None,
-        tie_break_seed: int | None,
-        progress: Callable[[SearchStats], None] | None,
-        should_stop: Callable[[], bool] | None,
-        clock: Callable[[], float],
-        prefetch: Callable[[list[Edge[Any, Any]]], None] | None = None,
-        prefetch_depth: int = 0,
+        options: SearchOptions[Any, Any],
     ) -> None:
         self.successors = successors
         self.is_goal = is_goal
         self.heuristic = heuristic
-        self.weight = weight
-        self.greedy = greedy
-        self.deferred = deferred
-        self.dominates = dominates
-        self.dominance_key = dominance_key
-        self.dominance_ignores_g = dominance_ignores_g
-        self.dominance_index = dominance_index
-        self.reopen = reopen
-        self.max_nodes = max_nodes
-        self.timeout = timeout
-        self.progress = progress
-        self.should_stop = should_stop
-        self.clock = clock
-        self.prefetch = prefetch
-        self.prefetch_depth = prefetch_depth
-        self.rng = random.Random(tie_break_seed) if tie_break_seed is not None else None
+        self.weight = options.weight
+        self.greedy = options.greedy
+        self.deferred = options.deferred
+        self.dominates = options.dominates
+        self.dominance_key = options.dominance_key
+        self.dominance_ignores_g = options.dominance_ignores_g
+        self.dominance_index = options.dominance_index
+        self.reopen = options.reopen
+        self.max_nodes = options.max_nodes
+        self.timeout = options.timeout
+        self.progress = options.progress
+        self.should_stop = options.should_stop
+        self.clock = options.clock
+        self.prefetch = options.prefetch
+        self.prefetch_depth = options.prefetch_depth
+        seed = options.tie_break_seed
+        self.rng = random.Random(seed) if seed is not None else None
 
         self.stats = SearchStats()
         self.best: Any = None
@@ -574,45 +560,13 @@ class _Search:
         )
 
 
-def best_first_search(
-    start: S,
-    successors: Callable[[S], Iterable[Edge[S, A]]],
-    is_goal: Callable[[S], bool],
-    heuristic: Callable[[S], float] = _blind,
-    *,
-    weight: float = 1.0,
-    greedy: bool = False,
-    deferred: bool = False,
-    dominates: Callable[[S, S], bool] | None = None,
-    dominance_key: Callable[[S], Hashable] | None = None,
-    dominance_ignores_g: bool = False,
-    dominance_index: DominanceIndex | None = None,
-    reopen: bool = True,
-    max_nodes: int | None = 5000,
-    timeout: float | None = None,
-    tie_break_seed: int | None = None,
-    progress: Callable[[SearchStats], None] | None = None,
-    should_stop: Callable[[], bool] | None = None,
-    clock: Callable[[], float] = time.monotonic,
-    prefetch: Callable[[list[Edge[S, A]]], None] | None = None,
-    prefetch_depth: int = 4,
-) -> SearchResult[S, A]:
-    """Best-first search from ``start`` to a state satisfying ``is_goal``.
+@dataclass(frozen=True)
+class SearchOptions(Generic[S, A]):
+    """How :func:`best_first_search` searches, as one value; every field has its default.
+    Bad values raise ``ValueError`` when it is made.
 
-    Parameters
-    ----------
-    start
-        The initial state. States must be hashable and immutable; equal states are duplicates.
-    successors
-        ``successors(s)`` yields the outgoing :class:`Edge` objects of ``s``. Called once per
-        expansion. Edge costs must be finite and non-negative (``ValueError`` otherwise).
-    is_goal
-        Goal test, applied when a node is selected for expansion (never at generation).
-    heuristic
-        Estimate of the remaining cost; ``math.inf`` marks a dead end (the state is pruned).
-        Must be a function of the state: values are cached, finite ones for as long as the
-        search runs, dead ends in a cache of the :data:`DEAD_END_CACHE` most recently seen
-        (a dead end met again after leaving it is evaluated again). Default: blind (0).
+    Fields:
+
     weight
         Open list ordered by ``f = g + weight * h``: 1 is A*, > 1 weighted A* (plans cost at
         most ``weight`` times the optimum for an admissible heuristic), 0 uniform cost. Ignored
@@ -669,6 +623,71 @@ def best_first_search(
         edges in the same order, calling ``make_child`` as it would without it.
     prefetch_depth
         Open entries looked at for ``prefetch`` in deferred mode (at most 10).
+    """
+
+    weight: float = 1.0
+    greedy: bool = False
+    deferred: bool = False
+    dominates: Callable[[S, S], bool] | None = None
+    dominance_key: Callable[[S], Hashable] | None = None
+    dominance_ignores_g: bool = False
+    dominance_index: DominanceIndex | None = None
+    reopen: bool = True
+    max_nodes: int | None = 5000
+    timeout: float | None = None
+    tie_break_seed: int | None = None
+    progress: Callable[[SearchStats], None] | None = None
+    should_stop: Callable[[], bool] | None = None
+    clock: Callable[[], float] = time.monotonic
+    prefetch: Callable[[list[Edge[S, A]]], None] | None = None
+    prefetch_depth: int = 4
+
+    def __post_init__(self) -> None:
+        weight, max_nodes, timeout = self.weight, self.max_nodes, self.timeout
+        if not weight >= 0.0 or weight == math.inf:
+            raise ValueError(f"weight must be finite and non-negative, got {weight!r}")
+        if max_nodes is not None and max_nodes < 0:
+            raise ValueError(f"max_nodes must be non-negative or None, got {max_nodes!r}")
+        if timeout is not None and not timeout >= 0.0:
+            raise ValueError(f"timeout must be non-negative or None, got {timeout!r}")
+        if self.dominance_key is not None and self.dominates is None:
+            raise ValueError("dominance_key is only meaningful together with dominates")
+        if self.dominance_index is not None and self.dominates is not None:
+            raise ValueError("give either dominates or dominance_index, not both")
+        if not 0 <= self.prefetch_depth <= 10:
+            raise ValueError(
+                f"prefetch_depth must be between 0 and 10, got {self.prefetch_depth!r}"
+            )
+        object.__setattr__(self, "weight", float(weight))
+
+
+def best_first_search(
+    start: S,
+    successors: Callable[[S], Iterable[Edge[S, A]]],
+    is_goal: Callable[[S], bool],
+    heuristic: Callable[[S], float] = _blind,
+    options: SearchOptions[S, A] | None = None,
+    **overrides: Any,
+) -> SearchResult[S, A]:
+    """Best-first search from ``start`` to a state satisfying ``is_goal``, as ``options``
+    say (None: the defaults of :class:`SearchOptions`) with ``overrides`` of its fields by name
+    (``best_first_search(s, succ, goal, h, max_nodes=50)``; an unknown name raises
+    ``TypeError``).
+
+    Parameters
+    ----------
+    start
+        The initial state. States must be hashable and immutable; equal states are duplicates.
+    successors
+        ``successors(s)`` yields the outgoing :class:`Edge` objects of ``s``. Called once per
+        expansion. Edge costs must be finite and non-negative (``ValueError`` otherwise).
+    is_goal
+        Goal test, applied when a node is selected for expansion (never at generation).
+    heuristic
+        Estimate of the remaining cost; ``math.inf`` marks a dead end (the state is pruned).
+        Must be a function of the state: values are cached, finite ones for as long as the
+        search runs, dead ends in a cache of the :data:`DEAD_END_CACHE` most recently seen
+        (a dead end met again after leaving it is evaluated again). Default: blind (0).
 
     Returns
     -------
@@ -684,40 +703,8 @@ def best_first_search(
     ValueError
         For an invalid parameter, a negative, infinite or NaN edge cost, or a NaN heuristic.
     """
-    if not weight >= 0.0 or weight == math.inf:
-        raise ValueError(f"weight must be finite and non-negative, got {weight!r}")
-    if max_nodes is not None and max_nodes < 0:
-        raise ValueError(f"max_nodes must be non-negative or None, got {max_nodes!r}")
-    if timeout is not None and not timeout >= 0.0:
-        raise ValueError(f"timeout must be non-negative or None, got {timeout!r}")
-    if dominance_key is not None and dominates is None:
-        raise ValueError("dominance_key is only meaningful together with dominates")
-    if dominance_index is not None and dominates is not None:
-        raise ValueError("give either dominates or dominance_index, not both")
-    if not 0 <= prefetch_depth <= 10:
-        raise ValueError(f"prefetch_depth must be between 0 and 10, got {prefetch_depth!r}")
-    search = _Search(
-        successors,
-        is_goal,
-        heuristic,
-        weight=float(weight),
-        greedy=greedy,
-        deferred=deferred,
-        dominates=dominates,
-        dominance_key=dominance_key,
-        dominance_ignores_g=dominance_ignores_g,
-        dominance_index=dominance_index,
-        reopen=reopen,
-        max_nodes=max_nodes,
-        timeout=timeout,
-        tie_break_seed=tie_break_seed,
-        progress=progress,
-        should_stop=should_stop,
-        clock=clock,
-        prefetch=prefetch,
-        prefetch_depth=prefetch_depth,
-    )
-    return search.run(start)
+    chosen: SearchOptions[S, A] = replace(options or SearchOptions(), **overrides)
+    return _Search(successors, is_goal, heuristic, chosen).run(start)
 
 
 def astar(

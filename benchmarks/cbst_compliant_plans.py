@@ -40,6 +40,7 @@ from arrange_up.cbst.features import Domain
 from arrange_up.cbst.model import train_cbst
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.io.domains import load
+from arrange_up.parallel import RunnerConfig
 from arrange_up.planning.planner import plan
 
 PROBLEMS = ("blocks-2", "blocks-3", "blocks-4", "blocks-7")
@@ -158,7 +159,11 @@ def result_line(label: str, problem, result, args: argparse.Namespace) -> str:
         line += f" ({result.reason})"
     if args.evaluate and result.actions is not None:
         score = evaluate_plan(
-            problem, result.actions, rollouts=args.evaluate, seed=0, workers=args.workers
+            problem,
+            result.actions,
+            rollouts=args.evaluate,
+            seed=0,
+            runner=RunnerConfig(workers=args.workers),
         )
         low, high = score.interval
         line += (

@@ -23,9 +23,11 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.io.domains import domain_names, load
 from arrange_up.model.problem import SERVO_CONTROLLER, Controller, ControllerKind
 from arrange_up.model.world import Push
+from arrange_up.planning.config import PlanConfig
 from arrange_up.planning.planner import plan
 from arrange_up.planning.task import BeliefTask
 
@@ -53,8 +55,7 @@ def follow_servo(name: str, kp: float | None) -> None:
     controller = Controller(kind=ControllerKind.COMPLIANT)
     if kp is not None:
         controller = replace(controller, kp=kp)
-    task = BeliefTask.build(
-        replace(servo, controller=controller),
+    config = PlanConfig.of(
         semantics="deterministic",
         particles=1,
         seed=0,
@@ -63,6 +64,7 @@ def follow_servo(name: str, kp: float | None) -> None:
         dominance=True,
         variety=False,
     )
+    task = BeliefTask.build(compile_problem(replace(servo, controller=controller)), config)
     belief = task.initial_belief()
     try:
         for k, action in enumerate(servo_plan):

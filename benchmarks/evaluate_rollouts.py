@@ -36,7 +36,14 @@ from arrange_up.evaluation.rollouts import RolloutContext, rollout_task
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.model.problem import problem_hash
-from arrange_up.parallel import _apply_chunk, _chunks, auto_chunksize, get_runner
+from arrange_up.parallel import (
+    SERIAL,
+    RunnerConfig,
+    _apply_chunk,
+    _chunks,
+    auto_chunksize,
+    get_runner,
+)
 from arrange_up.planning.planner import plan
 
 
@@ -117,18 +124,19 @@ def main() -> int:
 
     load_before = os.getloadavg()
     rows = []
-    evaluate_plan(problem, actions, rollouts=3, seed=10**6, workers=1)  # imports, caches
+    evaluate_plan(problem, actions, rollouts=3, seed=10**6, runner=SERIAL)  # imports, caches
     cpu0 = time.process_time()
-    serial, t1 = run(workers=1, keep_records=True)
+    serial, t1 = run(runner=SERIAL, keep_records=True)
     cpu1 = time.process_time() - cpu0
     records = serial.records
     serial = replace(serial, records=None)  # compare results, not kept records
     rows.append(("local, 1 worker (in process)", t1, 0.0))
 
     t0 = time.perf_counter()
-    evaluate_plan(problem, actions, rollouts=2 * w, seed=10**6, workers=w, chunksize=1)
+    on_w = RunnerConfig(workers=w)
+    evaluate_plan(problem, actions, rollouts=2 * w, seed=10**6, runner=on_w, chunksize=1)
     startup = time.perf_counter() - t0
-    local, tw = run(workers=w)
+    local, tw = run(runner=on_w)
     rows.append((f"local, {w} processes (loky)", tw, startup))
     assert local == serial, "local processes disagree with the serial run"
 
@@ -136,11 +144,10 @@ def main() -> int:
     if not args.no_dask:
         t0 = time.perf_counter()
         runner = get_runner("dask", workers=w)
-        evaluate_plan(
-            problem, actions, rollouts=2 * w, seed=10**6, backend="dask", workers=w, chunksize=1
-        )
+        on_dask_w = RunnerConfig(workers=w, backend="dask")
+        evaluate_plan(problem, actions, rollouts=2 * w, seed=10**6, runner=on_dask_w, chunksize=1)
         startup = time.perf_counter() - t0
-        on_dask, td = run(backend="dask", workers=w)
+        on_dask, td = run(runner=on_dask_w)
         rows.append((f"dask LocalCluster, {w} workers (client)", td, startup))
         assert on_dask == serial, "dask disagrees with the serial run"
         dask_rows.append(td)

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.io.yaml_problem import load_problem
+from arrange_up.parallel import SERIAL
 from arrange_up.planning.planner import plan
 
 FRESH = Path(__file__).resolve().parents[1] / "tests" / "problems" / "fresh"
@@ -94,7 +95,9 @@ def measure(
         "reason": result.reason or "",
     }
     if result.solved and rollouts:
-        reliability = evaluate_plan(problem, result.actions, rollouts=rollouts, seed=0, workers=1)
+        reliability = evaluate_plan(
+            problem, result.actions, rollouts=rollouts, seed=0, runner=SERIAL
+        )
         row.update(rollouts=reliability.trials, successes=reliability.successes)
     return row
 

@@ -96,6 +96,7 @@ def run_one(
     from arrange_up.evaluation.evaluate import evaluate_plan
     from arrange_up.io.generate import generate_problem
     from arrange_up.io.yaml_problem import load_problem_text
+    from arrange_up.parallel import SERIAL
     from arrange_up.planning.planner import plan
 
     problem = load_problem_text(generate_problem(family, parts, seed))
@@ -119,7 +120,7 @@ def run_one(
     }
     if result.solved:
         reliability = evaluate_plan(
-            problem, result.actions, rollouts=rollouts, seed=seed, workers=1
+            problem, result.actions, rollouts=rollouts, seed=seed, runner=SERIAL
         )
         row.update(
             rollouts=reliability.trials,

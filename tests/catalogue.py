@@ -21,6 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from functools import cache
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.model.problem import SERVO_CONTROLLER, ArrangementProblem
 from arrange_up.planning.config import PlanConfig
@@ -233,7 +234,7 @@ def particle_task(
 ) -> Iterator[BeliefTask]:
     """The search task ``plan(problem, particles=particles, seed=seed, workers=1)`` builds
     (particle semantics, the inadmissible heuristic, dominance, no variety), closed on leaving."""
-    task = BeliefTask.build(problem, PlanConfig(particles=particles, seed=seed))
+    task = BeliefTask.build(compile_problem(problem), PlanConfig(particles=particles, seed=seed))
     try:
         yield task
     finally:

@@ -26,6 +26,7 @@ from typing import Any
 import arrange_up
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.model.problem import SERVO_CONTROLLER
+from arrange_up.parallel import SERIAL
 from arrange_up.repair import repair_plan
 
 GOLDEN_DIR = Path(__file__).parent / "goldens"
@@ -100,7 +101,7 @@ def _evaluation_case(
             validate=validate,
             agenda=False,  # the goldens pin the whole goal's search
         )
-        reliability = evaluate_plan(problem, result.actions, rollouts=200, seed=0, workers=1)
+        reliability = evaluate_plan(problem, result.actions, rollouts=200, seed=0, runner=SERIAL)
         data = plain(reliability.to_json())
         for key in ("backend", "workers", "resumed"):  # how the run was made, not its result
             data.pop(key)

@@ -12,6 +12,7 @@ from arrange_up import parallel
 from arrange_up.parallel import (
     BackendUnavailableError,
     LocalRunner,
+    RunnerConfig,
     SerialRunner,
     auto_chunksize,
     get_runner,
@@ -113,14 +114,16 @@ def test_dask_local_cluster_matches_local_processes(tmp_path):
         runner = get_runner("dask", workers=2)
         assert runner.workers == 2 and get_runner("dask", workers=2) is runner
         assert sorted(runner.map(_square, range(7), chunksize=2)) == [(i, i * i) for i in range(7)]
-        on_dask = evaluate_plan(problem, actions, rollouts=20, seed=0, backend="dask", workers=2)
+        on_dask = evaluate_plan(
+            problem, actions, rollouts=20, seed=0, runner=RunnerConfig(workers=2, backend="dask")
+        )
         # a session's task whose worker dies with it is run again: the same answer
         marker = tmp_path / "died"
         assert runner.session(_die_once, str(marker)).submit(41).result() == 42
         assert marker.exists()
     finally:
         parallel.shutdown()
-    local = evaluate_plan(problem, actions, rollouts=20, seed=0, workers=2)
+    local = evaluate_plan(problem, actions, rollouts=20, seed=0, runner=RunnerConfig(workers=2))
     assert on_dask == local
     assert on_dask.backend == "dask" and on_dask.workers == 2
 

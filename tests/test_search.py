@@ -13,6 +13,7 @@ import pytest
 
 from arrange_up.search import (
     Edge,
+    SearchOptions,
     SearchResult,
     SearchStats,
     SearchStatus,
@@ -674,6 +675,25 @@ def test_invalid_arguments() -> None:
         best_first_search(0, line_successors, lambda n: n == 3, dominance_key=lambda n: n)
     with pytest.raises(ValueError):
         best_first_search(0, line_successors, lambda n: n == 3, lambda n: math.nan)
+
+
+def test_options_as_one_value_and_as_overrides() -> None:
+    options = SearchOptions[int, str](max_nodes=2, deferred=True)
+    given = best_first_search(0, line_successors, lambda n: n == 3, options=options)
+    named = best_first_search(0, line_successors, lambda n: n == 3, max_nodes=2, deferred=True)
+    assert given.status is named.status is SearchStatus.NODE_LIMIT
+    assert given.stats.expanded == named.stats.expanded == 2
+    # an override replaces the one field, the others stay the options'
+    more = best_first_search(0, line_successors, lambda n: n == 3, options=options, max_nodes=9)
+    same = best_first_search(0, line_successors, lambda n: n == 3, max_nodes=9, deferred=True)
+    eager = best_first_search(0, line_successors, lambda n: n == 3, max_nodes=9)
+    assert more.solved() and more.plan == ("+", "+", "+")
+    counts = [(r.stats.evaluated, r.stats.generated) for r in (more, same, eager)]
+    assert counts[0] == counts[1] != counts[2]  # still deferred: fewer children evaluated
+    with pytest.raises(ValueError, match="weight"):
+        SearchOptions(weight=-1.0)
+    with pytest.raises(TypeError):
+        best_first_search(0, line_successors, lambda n: n == 3, max_node=2)
 
 
 @pytest.mark.parametrize(("dead_ends", "evaluations"), [(2, 2), (3, 12)])

@@ -6,7 +6,9 @@ and the repair all derive the same things from an
 obstacle boxes, belief shadows), its angle frame and its goal test. A :class:`CompiledProblem`
 builds each on first use and keeps it; :func:`compile_problem` returns the one of a problem
 object (kept for the few problems most recently asked for), so the consumers of one run share
-one of each instead of each building its own.
+one of each instead of each building its own. The planner compiles its problem once and hands
+the compiled problem down (its search, task, action generator, heuristic, workers and
+validation), not the problem.
 """
 
 from __future__ import annotations
@@ -27,6 +29,11 @@ class CompiledProblem:
 
     def __init__(self, problem: ArrangementProblem) -> None:
         self.problem = problem
+
+    def __reduce__(self) -> tuple[object, tuple[ArrangementProblem]]:
+        """Pickled as its problem alone, and compiled again where it is unpickled (a worker
+        builds its own members on first use, where shipping them would cost more)."""
+        return compile_problem, (self.problem,)
 
     @cached_property
     def checker(self) -> CollisionChecker:

@@ -23,10 +23,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache, cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.problem import (
     ArrangementProblem,
     HalfWidths,
@@ -36,6 +36,9 @@ from arrange_up.model.problem import (
     as_triple,
 )
 from arrange_up.model.world import WorldState
+
+if TYPE_CHECKING:  # the compiled problem holds this module's AngleFrame: imported for types only
+    from arrange_up.belief.compiled import CompiledProblem
 
 TWO_PI = 2.0 * math.pi
 
@@ -285,23 +288,20 @@ class ParticleBelief:
 
 
 def sample_initial_particles(
-    problem: ArrangementProblem,
+    compiled: CompiledProblem,
     n: int,
     rng: np.random.Generator,
     *,
-    frame: AngleFrame | None = None,
-    checker: CollisionChecker | None = None,
     max_tries_per_particle: int = 1000,
 ) -> ParticleBelief:
-    """Draw ``n`` initial world states uniformly from the initial intervals, rejecting samples
-    in which objects overlap each other, an obstacle or a wall (thesis §3.1).
+    """Draw ``n`` initial world states of ``compiled.problem`` uniformly from the initial
+    intervals, rejecting samples in which objects overlap each other, an obstacle or a wall
+    (thesis §3.1), by the compiled problem's collision checker and in its angle frame.
 
     Raises ``ValueError`` if a particle cannot be drawn in ``max_tries_per_particle`` tries
-    (an initial belief that is almost all collisions). ``frame`` and ``checker``: the
-    problem's, when the caller has them already.
+    (an initial belief that is almost all collisions).
     """
-    checker = checker or CollisionChecker(problem)
-    frame = frame or AngleFrame.of(problem)
+    problem, checker, frame = compiled.problem, compiled.checker, compiled.frame
     states = []
     for _ in range(n):
         for _attempt in range(max_tries_per_particle):

@@ -33,7 +33,7 @@ from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.evaluation.reliability import EvaluationProgress, FailureBreakdown
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action, Push
-from arrange_up.parallel import BackendUnavailableError
+from arrange_up.parallel import BackendUnavailableError, RunnerConfig
 
 
 def _describe_action(actions: Sequence[Action], index: int) -> str:
@@ -167,9 +167,7 @@ def evaluate(
                 actions,
                 rollouts=rollouts,
                 seed=seed,
-                workers=workers,
-                backend=backend,
-                scheduler=scheduler,
+                runner=RunnerConfig(workers, backend, scheduler),
                 record=record,
                 progress=update,
                 landing=landing,

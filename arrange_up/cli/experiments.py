@@ -61,7 +61,7 @@ from arrange_up.experiments.planning import (
     transition_markdown,
 )
 from arrange_up.model.problem import ControllerKind
-from arrange_up.parallel import BackendUnavailableError
+from arrange_up.parallel import BackendUnavailableError, RunnerConfig
 from arrange_up.repair import METHODS
 from arrange_up.transitions import available
 
@@ -583,9 +583,7 @@ def experiment_fixtures(
                 seed=seed,
                 method=method,
                 timeout=timeout,
-                workers=workers,
-                backend=backend,
-                scheduler=scheduler,
+                runner=RunnerConfig(workers, backend, scheduler),
                 ablation=ablation,
                 controller=controller,
                 progress=report.say,

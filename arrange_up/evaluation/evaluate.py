@@ -56,7 +56,7 @@ from arrange_up.evaluation.rollouts import (
 )
 from arrange_up.model.problem import ArrangementProblem, ObjectKind, problem_hash
 from arrange_up.model.world import Action, Pick, Place, Push
-from arrange_up.parallel import BACKENDS, auto_chunksize, get_runner
+from arrange_up.parallel import RunnerConfig, auto_chunksize
 from arrange_up.physics.simulation import DEFAULT_SETTINGS
 
 __all__ = ["evaluate_plan"]
@@ -68,9 +68,7 @@ def evaluate_plan(
     *,
     rollouts: int = 1000,
     seed: int = 0,
-    workers: int | None = None,
-    backend: str = "local",
-    scheduler: str | None = None,
+    runner: RunnerConfig | None = None,
     record: str | Path | None = None,
     progress: ProgressCallback | None = None,
     chunksize: int | None = None,
@@ -86,11 +84,13 @@ def evaluate_plan(
         Number of rollouts (indices ``0 .. rollouts - 1``).
     seed
         Non-negative integer; rollout ``i`` draws from ``default_rng([seed, i])``, so results
-        do not depend on ``workers``, ``backend`` or ``chunksize``.
-    workers, backend, scheduler
-        Where rollouts run (:func:`arrange_up.parallel.get_runner`): ``"local"`` processes
-        (``workers=None``: every core; 1 runs in this process) or ``"dask"`` (a LocalCluster
-        of ``workers`` processes, or the cluster at the ``scheduler`` address).
+        do not depend on ``runner`` or ``chunksize``.
+    runner
+        Where rollouts run (:class:`arrange_up.parallel.RunnerConfig`): ``"local"`` processes
+        (``workers=None``: every core; 1 runs in this process,
+        :data:`~arrange_up.parallel.SERIAL`) or ``"dask"`` (a LocalCluster of ``workers``
+        processes, or the cluster at the ``scheduler`` address). None: local processes on
+        every core.
     record
         A ``.jsonl`` file that every finished rollout is appended to; an existing file of the
         same evaluation is resumed (see :mod:`arrange_up.evaluation.records`).
@@ -127,8 +127,7 @@ def evaluate_plan(
     started = time.perf_counter()
     check_count("rollouts", rollouts)
     check_count("seed", seed, minimum=0)
-    if backend not in BACKENDS:
-        raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
+    runner = RunnerConfig(workers=None) if runner is None else runner
     if chunksize is not None:
         check_count("chunksize", chunksize)
     check_landing(landing)
@@ -152,17 +151,17 @@ def evaluate_plan(
         records = {i: r for i, r in file.records.items() if i < rollouts}
     resumed = len(records)
     successes = sum(r.success for r in records.values())
-    runner_backend, runner_workers = backend, 1
+    runner_backend, runner_workers = runner.backend, 1
     try:
         todo = [i for i in range(rollouts) if i not in records]
         if progress is not None:
             progress(EvaluationProgress(resumed, rollouts, successes, 0.0, resumed))
         if todo and not (should_stop is not None and should_stop()):
-            runner = get_runner(backend, workers, scheduler)
-            runner_workers = runner.workers
-            size = chunksize or auto_chunksize(len(todo), runner.workers)
+            pool = runner.runner()
+            runner_workers = pool.workers
+            size = chunksize or auto_chunksize(len(todo), pool.workers)
             context = RolloutContext(f"{phash} {lhash} {landing}", problem, actions, seed, landing)
-            results = runner.map(partial(rollout_task, context), todo, size)
+            results = pool.map(partial(rollout_task, context), todo, size)
             for index, result in results:
                 records[index] = result
                 successes += result.success

@@ -40,8 +40,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from arrange_up.belief.compiled import compile_problem
-from arrange_up.belief.states import AngleFrame, sample_initial_particles
+from arrange_up.belief.compiled import CompiledProblem, compile_problem
+from arrange_up.belief.states import sample_initial_particles
 from arrange_up.evaluation.outcomes import (
     ACTION_FAILED,
     GOAL_MISSED,
@@ -139,7 +139,7 @@ class Rollouts:
         self.push_settings = (
             settings if landing == "fail" else replace(settings, overlap_tolerance=math.inf)
         )
-        compiled = compile_problem(problem)
+        self.compiled = compiled = compile_problem(problem)
         self.goal = compiled.goal
         self.frame = compiled.frame
         self.depths = PenetrationDepths(problem)
@@ -148,7 +148,7 @@ class Rollouts:
         """Rollout ``index`` of an evaluation with ``seed``; the states it passes through are
         appended to ``trace`` when given (as :attr:`Execution.states`)."""
         rng = np.random.default_rng([seed, index])
-        state = _draw_start(self.problem, rng, self.frame)
+        state = _draw_start(self.compiled, rng)
         states = [] if trace is None else trace
         states.append(state)
         state, failure = self._execute(state, rng, states)
@@ -260,19 +260,16 @@ def execute_plan(
     return Rollouts(problem, actions, settings, landing).execute(state, rng)
 
 
-def _draw_start(
-    problem: ArrangementProblem, rng: np.random.Generator, frame: AngleFrame
-) -> WorldState:
+def _draw_start(compiled: CompiledProblem, rng: np.random.Generator) -> WorldState:
     """Step 1 of a rollout: its initial state, the first draws of its generator."""
-    checker = compile_problem(problem).checker
-    return sample_initial_particles(problem, 1, rng, frame=frame, checker=checker).particles[0]
+    return sample_initial_particles(compiled, 1, rng).particles[0]
 
 
 def rollout_start(problem: ArrangementProblem, seed: int, index: int) -> WorldState:
     """The initial state rollout ``index`` of an evaluation with ``seed`` starts from (the state
     :func:`trace_rollout` begins with), drawn without running the rollout."""
     rng = np.random.default_rng([seed, index])
-    return _draw_start(problem, rng, compile_problem(problem).frame)
+    return _draw_start(compile_problem(problem), rng)
 
 
 def simulate_rollout(

@@ -152,12 +152,13 @@ class ParticleFilter:
         #: The noise scale the filter propagates with: 1 (the problem's model) until a model
         #: failure was recovered at a wider scale, with ``adapt``, then that scale.
         self.scale = 1.0
-        self.frame = compile_problem(problem).frame
+        self.compiled = compile_problem(problem)
+        self.frame = self.compiled.frame
         self._rollouts = {1.0: Rollouts(problem, (), landing=landing)}
 
     def initial(self) -> ParticleBelief:
         """The prior: particles drawn from the problem's initial intervals."""
-        return sample_initial_particles(self.problem, self.particles, self.rng, frame=self.frame)
+        return sample_initial_particles(self.compiled, self.particles, self.rng)
 
     def update(
         self, belief: ParticleBelief, action: Action, index: int, observation: Observation

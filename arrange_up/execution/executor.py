@@ -112,9 +112,8 @@ class SimulatedExecutor:
         self.rollouts = Rollouts(self.world, (), landing=landing)
         self.rng = np.random.default_rng([seed, episode])
         self.sense_rng = np.random.default_rng([seed, episode, 0x5E45E])
-        world = compile_problem(self.world)
         self.state: WorldState = sample_initial_particles(
-            self.world, 1, self.rng, frame=world.frame, checker=world.checker
+            compile_problem(self.world), 1, self.rng
         ).particles[0]
         #: The true state before the first action, then after each (for storyboards).
         self.trace: list[WorldState] = [self.state]

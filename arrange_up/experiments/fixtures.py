@@ -51,6 +51,7 @@ fixtures where the rows have them) and one
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -66,7 +67,7 @@ from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys,
 from arrange_up.experiments.problems import controller_setting, driven_problems, physics_setting
 from arrange_up.figures.backend import pyplot
 from arrange_up.model.world import Push
-from arrange_up.parallel import available_cores
+from arrange_up.parallel import RunnerConfig, available_cores
 from arrange_up.repair import METHODS, nominal_plans, repair_plan
 
 __all__ = [
@@ -157,9 +158,7 @@ def fixture_experiment(
     seed: int = 0,
     method: str = "enhanced",
     timeout: float | None = None,
-    workers: int | None = None,
-    backend: str = "local",
-    scheduler: str | None = None,
+    runner: RunnerConfig | None = None,
     max_tries: int | None = None,
     ablation: bool = True,
     controller: str | None = None,
@@ -171,10 +170,10 @@ def fixture_experiment(
     Rows go to ``output_dir/fixtures.csv`` (columns :data:`FIXTURE_FIELDS`), then the PNGs
     are drawn next to it. ``plans`` is ``K``; ``rollouts`` 0 skips every evaluation (the
     evaluation columns stay empty). ``method`` and ``timeout`` (seconds per repair; the thesis
-    allowed 24 hours) go to :func:`~arrange_up.repair.repair_plan`, ``workers`` to
-    it and to
-    :func:`~arrange_up.evaluation.evaluate.evaluate_plan` (default: every core), ``backend`` and
-    ``scheduler`` to the evaluation only. ``max_tries`` is passed to ``nominal_plans``
+    allowed 24 hours) go to :func:`~arrange_up.repair.repair_plan`; ``runner`` (None: local
+    processes on every core) is where the evaluations run
+    (:func:`~arrange_up.evaluation.evaluate.evaluate_plan`), and its worker count (every core
+    when it has none) goes to the repair too. ``max_tries`` is passed to ``nominal_plans``
     (default ``10 * max(plans, 20) + 10``, independent of ``plans`` up to 20, which keeps the
     plan lists of different ``plans`` prefixes of each other). ``ablation`` adds the repairs
     without fixtures (stage ``ablation``); ``controller`` (``"compliant"`` or ``"servo"``)
@@ -193,7 +192,9 @@ def fixture_experiment(
         raise ValueError(f"rollouts must be 0 or more, got {rollouts!r}")
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
-    workers = workers or available_cores()
+    runner = runner or RunnerConfig(workers=None)
+    workers = runner.workers or available_cores()
+    runner = dataclasses.replace(runner, workers=workers)
     tries = max_tries if max_tries is not None else 10 * max(plans, 20) + 10
     path = Path(output_dir) / CSV_NAME
     _check_columns(path)
@@ -210,9 +211,7 @@ def fixture_experiment(
             actions,
             rollouts=rollouts,
             seed=seed,
-            workers=workers,
-            backend=backend,
-            scheduler=scheduler,
+            runner=runner,
         )
         say(f"{what}: {result.successes}/{result.trials} rollouts reached the goal")
         return {

@@ -35,7 +35,7 @@ from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
 from arrange_up.experiments.problems import controller_setting, driven_problems, physics_setting
 from arrange_up.figures.backend import pyplot
-from arrange_up.parallel import available_cores
+from arrange_up.parallel import RunnerConfig, available_cores
 from arrange_up.planning.planner import plan
 from arrange_up.transitions import available
 
@@ -181,7 +181,7 @@ def transition_comparison(
                             result.actions,
                             rollouts=rollouts,
                             seed=run,
-                            workers=workers,
+                            runner=RunnerConfig(workers=workers),
                         )
                         row.update(
                             rollouts=reliability.trials,

@@ -41,10 +41,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from arrange_up.belief.compiled import CompiledProblem
 from arrange_up.belief.goals import EPS, GoalTest
 from arrange_up.belief.states import ParticleBelief
-from arrange_up.geometry.collision import CollisionChecker
-from arrange_up.model.problem import ArrangementProblem
 from arrange_up.planning.actions import ActionGenerator
 
 HEURISTICS = ("inadmissible", "admissible", "ordering", "manhattan", "blind")
@@ -70,13 +69,12 @@ def check_heuristic(name: str) -> None:
 
 def make_heuristic(
     name: str,
-    problem: ArrangementProblem,
-    goal: GoalTest,
-    checker: CollisionChecker,
+    compiled: CompiledProblem,
     generator: ActionGenerator | None = None,
     ordering_filter: bool = True,
 ) -> Heuristic:
-    """Build the named heuristic for one problem (see the module docstring).
+    """Build the named heuristic for ``compiled.problem``, on its goal test and collision
+    checker (see the module docstring).
 
     ``generator`` (the planner's action generator) lets the ordering filter recognise goal
     parts that can no longer be placed; without it that part of the filter is off.
@@ -85,7 +83,8 @@ def make_heuristic(
     again without it.
     """
     check_heuristic(name)
-    ordering = _OrderingFilter(problem, goal, checker, generator)
+    problem, goal = compiled.problem, compiled.goal
+    ordering = _OrderingFilter(compiled, generator)
     violated = ordering.violated if ordering_filter else _never
 
     def blind(_: ParticleBelief) -> float:
@@ -182,14 +181,9 @@ def _coords_partial(goal: GoalTest, belief: ParticleBelief, present: list[bool])
 class _OrderingFilter:
     """Detects goal parts that share a goal row/column but sit in it in the wrong order."""
 
-    def __init__(
-        self,
-        problem: ArrangementProblem,
-        goal: GoalTest,
-        checker: CollisionChecker,
-        generator: ActionGenerator | None,
-    ):
-        self.checker = checker
+    def __init__(self, compiled: CompiledProblem, generator: ActionGenerator | None):
+        self.checker = checker = compiled.checker
+        goal = compiled.goal
         self.generator = generator if goal.reference is None else None
         self.goal = goal
         self.goal_parts = goal.parts

@@ -17,6 +17,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
 from typing import Any, Self
 
+from arrange_up.belief.compiled import CompiledProblem, compile_problem
 from arrange_up.belief.goals import PartMiss
 from arrange_up.belief.states import ParticleBelief
 from arrange_up.io.planfile import plan_document
@@ -358,7 +359,7 @@ def plan(
             tell: ProgressCallback | None,
         ) -> PlanResult:
             return _searched(
-                goal,
+                compile_problem(goal),
                 PlanConfig.of(sized, max_nodes=nodes),
                 timeout=seconds,
                 progress=tell,
@@ -404,13 +405,13 @@ def plan(
             rounds.append(ValidationRound(size, result.status, result.stats["expanded"], None))
             break
         run, successes, failed = validate_plan(
-            problem,
+            compile_problem(problem),
             result.actions,  # type: ignore[arg-type]  # set when solved
             rollouts=validate,
             seed=config.seed,
             round_=round_,
+            runner=runner,
             should_stop=stop,
-            **runner.as_options(),
         )
         rounds.append(
             ValidationRound(size, result.status, result.stats["expanded"], successes, run)
@@ -443,19 +444,19 @@ def _numbered(progress: ProgressCallback, number: int, stats: dict[str, Any]) ->
 
 
 def _searched(
-    problem: ArrangementProblem, config: PlanConfig, *, timeout: float | None, **options: Any
+    compiled: CompiledProblem, config: PlanConfig, *, timeout: float | None, **options: Any
 ) -> PlanResult:
     """:func:`_search`, and where the ordering filter left nothing to search (the search ran
     out of beliefs having cut some as dead ends, the start perhaps), the search again without
     the filter in the nodes and time left: the filter is a heuristic, and ``exhausted`` must
     mean that the space was searched. The statistics count both searches."""
     started = time.monotonic()
-    first = _search(problem, config, timeout=timeout, **options)
+    first = _search(compiled, config, timeout=timeout, **options)
     if first.status != SearchStatus.EXHAUSTED or not first.statistics.pruned_infinite:
         return first
-    max_nodes = config.search.node_limit(problem.planning.max_nodes)
+    max_nodes = config.search.node_limit(compiled.problem.planning.max_nodes)
     again = _search(
-        problem,
+        compiled,
         PlanConfig.of(
             config, max_nodes=max_nodes - first.statistics.expanded, ordering_filter=False
         ),
@@ -466,7 +467,7 @@ def _searched(
 
 
 def _search(
-    problem: ArrangementProblem,
+    compiled: CompiledProblem,
     config: PlanConfig,
     *,
     timeout: float | None,
@@ -474,12 +475,13 @@ def _search(
     should_stop: Callable[[], bool] | None,
     start: Any,
 ) -> PlanResult:
-    """One best-first search of :func:`plan` under ``config`` (``timeout`` the seconds left of
-    the run), unvalidated."""
+    """One best-first search of :func:`plan` of ``compiled.problem`` under ``config``
+    (``timeout`` the seconds left of the run), unvalidated."""
     started = time.monotonic()
     options = config.search
+    problem = compiled.problem
     limit = options.node_limit(problem.planning.max_nodes)
-    task = BeliefTask.build(problem, config, start=start)
+    task = BeliefTask.build(compiled, config, start=start)
     # A learned prediction (CBST) costs less than shipping its job to a worker and back:
     # workers only slowed such a search down, so it runs in this process (same plan), and no
     # pool or cluster is started (nor a scheduler reached) for it.
@@ -491,7 +493,7 @@ def _search(
             task.close()
             raise
     index = task.dominance_index()
-    spec = WorkerSpec(problem, config)
+    spec = WorkerSpec(compiled, config)
     evaluator = SuccessorEvaluator(task, runner, spec, index)
 
     def report(stats: SearchStats) -> None:

@@ -50,8 +50,8 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from arrange_up.belief.compiled import CompiledProblem
 from arrange_up.belief.states import IntervalDominanceIndex, ParticleBelief
-from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Push
 from arrange_up.parallel import Pending, Runner, SerialRunner, Session
 from arrange_up.planning.config import PlanConfig
@@ -90,9 +90,10 @@ def first_share(belief: ParticleBelief, affected: frozenset[str]) -> tuple[int, 
 @dataclass(eq=False)
 class WorkerSpec:
     """What a worker needs to build the run's :class:`BeliefTask` (shipped once per worker;
-    the task is built on first use and kept with the unpickled spec)."""
+    the task is built on first use and kept with the unpickled spec; the compiled problem
+    travels as its problem and is compiled again in the worker)."""
 
-    problem: ArrangementProblem
+    compiled: CompiledProblem
     config: PlanConfig
     _task: BeliefTask | None = field(default=None, repr=False)
     _lock: Any = field(default=None, repr=False)
@@ -111,7 +112,7 @@ class WorkerSpec:
             # a worker only resolves transitions and heuristic values: no dominance, and the
             # pushes it is given are already varied
             config = PlanConfig.of(self.config, dominance=False, variety=False)
-            self._task = BeliefTask.build(self.problem, config)
+            self._task = BeliefTask.build(self.compiled, config)
         return self._task
 
     def lock(self) -> Any:

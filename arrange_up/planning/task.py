@@ -18,10 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from arrange_up.belief.compiled import compile_problem
+from arrange_up.belief.compiled import CompiledProblem
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import IntervalDominanceIndex
-from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Push
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.planning.config import PlanConfig
@@ -69,16 +68,18 @@ class BeliefTask:
 
     @classmethod
     def build(
-        cls, problem: ArrangementProblem, config: PlanConfig, *, start: Any = None
+        cls, compiled: CompiledProblem, config: PlanConfig, *, start: Any = None
     ) -> BeliefTask:
-        """The task of one search of ``problem`` under ``config`` from ``start`` (None: the
-        problem's initial belief). Successors are computed whole by the search's runner, so
-        the semantics starts no pool of its own.
+        """The task of one search of ``compiled.problem`` under ``config`` from ``start`` (None:
+        the problem's initial belief), its goal test, collision checker and action generator's
+        geometry taken from ``compiled``. Successors are computed whole by the search's runner,
+        so the semantics starts no pool of its own.
 
         The semantics is instantiated first (it may start worker processes); it is closed
         again if building the rest fails.
         """
         search = config.search
+        problem = compiled.problem
         model = make_semantics(
             config.semantics,
             problem,
@@ -88,11 +89,9 @@ class BeliefTask:
             model=config.model,
         )
         try:
-            compiled = compile_problem(problem)
-            checker, goal = compiled.checker, compiled.goal
             generator = ActionGenerator(
                 problem,
-                checker,
+                compiled.checker,
                 unclipped_pushes=model.refuses_uncertain_contacts,
                 settled_wall_pushes=not model.simulates_pushes,
                 compressed_wall_pushes=not model.simulates_pushes,
@@ -100,18 +99,13 @@ class BeliefTask:
                 clearance_pushes=model.particles > 1,
             )
             estimate = make_heuristic(
-                search.heuristic,
-                problem,
-                goal,
-                checker,
-                generator,
-                ordering_filter=search.ordering_filter,
+                search.heuristic, compiled, generator, ordering_filter=search.ordering_filter
             )
         except BaseException:
             model.close()
             raise
         variety_seed = config.seed if search.variety else None
-        return cls(model, goal, generator, estimate, search.dominance, variety_seed, start)
+        return cls(model, compiled.goal, generator, estimate, search.dominance, variety_seed, start)
 
     def initial_belief(self) -> Any:
         """The belief the search starts from: :attr:`start` when given, else the semantics'

@@ -35,12 +35,13 @@ from typing import Any
 
 import numpy as np
 
+from arrange_up.belief.compiled import CompiledProblem
 from arrange_up.counts import check_count
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.evaluation.rollouts import rollout_start
-from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, WorldState
+from arrange_up.parallel import SERIAL, RunnerConfig
 
 __all__ = [
     "MIN_VALIDATION_ROLLOUTS",
@@ -248,31 +249,28 @@ class Validation:
 
 
 def validate_plan(
-    problem: ArrangementProblem,
+    compiled: CompiledProblem,
     actions: tuple[Action, ...],
     *,
     rollouts: int,
     seed: int,
     round_: int,
-    workers: int = 1,
-    backend: str = "local",
-    scheduler: str | None = None,
+    runner: RunnerConfig = SERIAL,
     should_stop: Callable[[], bool] | None = None,
 ) -> tuple[int, int, tuple[WorldState, ...]]:
-    """Run ``rollouts`` rollouts of ``actions`` with :func:`validation_seed` ``(seed, round_)``
-    (on the evaluation's runner: ``workers``, ``backend``, ``scheduler`` as for
-    :func:`~arrange_up.evaluation.evaluate.evaluate_plan`), starting no more once
+    """Run ``rollouts`` rollouts of ``actions`` in ``compiled.problem`` with
+    :func:`validation_seed` ``(seed, round_)`` (on ``runner``, as
+    :func:`~arrange_up.evaluation.evaluate.evaluate_plan` runs them), starting no more once
     ``should_stop()`` returns True; return how many ran, their successes, and the initial
     states of the failed ones, in rollout order."""
     vseed = validation_seed(seed, round_)
+    problem = compiled.problem
     reliability = evaluate_plan(
         problem,
         actions,
         rollouts=rollouts,
         seed=vseed,
-        workers=workers,
-        backend=backend,
-        scheduler=scheduler,
+        runner=runner,
         keep_records=True,
         should_stop=should_stop,
     )

@@ -168,7 +168,7 @@ class ParticleSemantics:
         self.simulations = 0
         #: Why transitions were refused (:meth:`Simulated.refusal`), one count per refusal.
         self.reasons: Counter[str] = Counter()
-        compiled = compile_problem(problem)
+        self.compiled = compiled = compile_problem(problem)
         self.frame = compiled.frame
         self.checker = compiled.checker
         self._executor: Executor | None = None
@@ -204,9 +204,7 @@ class ParticleSemantics:
     # -- beliefs -----------------------------------------------------------------------------
     def initial_belief(self) -> ParticleBelief:
         rng = np.random.default_rng([self.seed, 0x1A1])
-        return sample_initial_particles(
-            self.problem, self.particles, rng, frame=self.frame, checker=self.checker
-        )
+        return sample_initial_particles(self.compiled, self.particles, rng)
 
     def apply(self, belief: ParticleBelief, action: Action) -> ParticleBelief | None:
         if isinstance(action, Push):

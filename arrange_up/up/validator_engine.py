@@ -44,6 +44,7 @@ from arrange_up.counts import check_count
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.outcomes import GOAL_MISSED
 from arrange_up.evaluation.reliability import EvaluationProgress
+from arrange_up.parallel import RunnerConfig
 from arrange_up.up.engine_base import (
     ArrangeUpEngine,
     check_parallel_params,
@@ -79,9 +80,7 @@ class ArrangeUpReliability(ArrangeUpEngine, PlanValidatorMixin):
         check_timeout(VALIDATOR_NAME, timeout)
         self._rollouts = rollouts
         self._seed = seed
-        self._workers = workers
-        self._backend = backend
-        self._scheduler = scheduler
+        self._runner = RunnerConfig(workers, backend, scheduler)
         self._timeout = timeout
 
     def _validate(self, problem: AbstractProblem, plan: Plan) -> ValidationResult:
@@ -115,9 +114,7 @@ class ArrangeUpReliability(ArrangeUpEngine, PlanValidatorMixin):
                 actions,
                 rollouts=self._rollouts,
                 seed=self._seed,
-                workers=self._workers,
-                backend=self._backend,
-                scheduler=self._scheduler,
+                runner=self._runner,
                 progress=watch,
             )
         except _OutOfTime:

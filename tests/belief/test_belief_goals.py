@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from catalogue import tiny
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import (
     IntervalBelief,
@@ -93,8 +94,8 @@ def test_interval_fit_and_domination():
 def test_initial_particles_are_collision_free_and_reproducible():
     p = tiny("relative-goal")
     checker = CollisionChecker(p)
-    a = sample_initial_particles(p, 20, np.random.default_rng(3))
-    b = sample_initial_particles(p, 20, np.random.default_rng(3))
+    a = sample_initial_particles(compile_problem(p), 20, np.random.default_rng(3))
+    b = sample_initial_particles(compile_problem(p), 20, np.random.default_rng(3))
     assert a == b
     assert not any(checker.state_collides(s) for s in a.particles)
     poses = a.poses

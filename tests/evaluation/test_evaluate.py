@@ -39,6 +39,7 @@ from arrange_up.model.problem import (
     Uncertainty,
 )
 from arrange_up.model.world import Pick, Place, Push, WorldState
+from arrange_up.parallel import SERIAL, RunnerConfig
 from arrange_up.planning.planner import plan
 
 EAST = -math.pi / 2  # paddle theta that pushes toward +x
@@ -96,12 +97,18 @@ def test_wilson_interval_known_values():
 # -- rollouts -----------------------------------------------------------------------------------
 def test_results_do_not_depend_on_workers_or_chunks(blocks2):
     problem, actions = blocks2
-    serial = evaluate_plan(problem, actions, rollouts=24, seed=3, workers=1, keep_records=True)
+    serial = evaluate_plan(problem, actions, rollouts=24, seed=3, runner=SERIAL, keep_records=True)
     assert serial.trials == 24 and 0 < serial.successes < 24
     assert serial.rate == serial.successes / 24
     assert serial.interval == wilson_interval(serial.successes, 24)
     pooled = evaluate_plan(
-        problem, actions, rollouts=24, seed=3, workers=2, chunksize=5, keep_records=True
+        problem,
+        actions,
+        rollouts=24,
+        seed=3,
+        runner=RunnerConfig(workers=2),
+        chunksize=5,
+        keep_records=True,
     )
     assert pooled == serial and pooled.workers == 2
     assert [r.index for r in serial.records] == list(range(24))
@@ -111,32 +118,32 @@ def test_results_do_not_depend_on_workers_or_chunks(blocks2):
         failed_at = None if record.success else record.failure.action
         assert len(states) == (len(actions) + 1 if failed_at is None else failed_at + 1)
         assert states[0].names() == ()  # blocks-2 starts with nothing on the table
-    other = evaluate_plan(problem, actions, rollouts=24, seed=4, workers=1)
+    other = evaluate_plan(problem, actions, rollouts=24, seed=4, runner=SERIAL)
     assert other != serial  # another seed draws other worlds
 
 
 def test_a_missed_goal_names_parts_and_dimensions():
     problem = load("blocks-1")
-    result = evaluate_plan(problem, [Place("A", (5.0, 2.5, 0.0))], rollouts=5, workers=1)
+    result = evaluate_plan(problem, [Place("A", (5.0, 2.5, 0.0))], rollouts=5, runner=SERIAL)
     assert result.successes == 0 and result.failures.goal_missed == 5
     dims = {(m.part, m.dimension): m for m in result.failures.goal_misses}
     assert set(dims) == {("A", "x"), ("A", "y")}
     assert dims[("A", "x")].rollouts == 5 and dims[("A", "x")].worst > 3.5
-    empty = evaluate_plan(problem, [], rollouts=2, workers=1)
+    empty = evaluate_plan(problem, [], rollouts=2, runner=SERIAL)
     assert [(m.part, m.dimension) for m in empty.failures.goal_misses] == [("A", "off table")]
 
 
 def test_inapplicable_actions_are_recorded_with_their_index_and_reason():
     problem = load("blocks-2")
     twice = [Place("A", (5.0, 2.5, 0.0)), Place("A", (3.0, 2.5, 0.0))]
-    result = evaluate_plan(problem, twice, rollouts=3, workers=1)
+    result = evaluate_plan(problem, twice, rollouts=3, runner=SERIAL)
     (failure,) = result.failures.action_failures
     assert (failure.action, failure.rollouts) == (1, 3)
     assert "already on the table" in failure.reason
-    picked = evaluate_plan(problem, [Pick("B")], rollouts=1, workers=1)
+    picked = evaluate_plan(problem, [Pick("B")], rollouts=1, runner=SERIAL)
     assert picked.failures.action_failed == 1
     stacked = [Place("A", (5.0, 2.5, 0.0)), Place("B", (5.3, 2.5, 0.0))]
-    result = evaluate_plan(problem, stacked, rollouts=2, workers=1, keep_records=True)
+    result = evaluate_plan(problem, stacked, rollouts=2, runner=SERIAL, keep_records=True)
     assert result.failures.action_failures[0].reason.startswith("placed overlapping A")
     assert result.records[0].failure.detail.startswith("overlap 0.")
 
@@ -160,13 +167,13 @@ def test_an_overlap_is_reported_in_the_files_length_unit():
     # inches)
     a, b = (10 / 2.54, 10 / 2.54, 0.0), (14 / 2.54, 10 / 2.54, 0.0)
     stacked = [Place("A", a), Place("B", b)]
-    result = evaluate_plan(problem, stacked, rollouts=1, workers=1, keep_records=True)
+    result = evaluate_plan(problem, stacked, rollouts=1, runner=SERIAL, keep_records=True)
     assert result.failures.action_failures[0].reason == (
         "placed overlapping A (by more than 0.0508 cm)"
     )
     assert result.records[0].failure.detail.endswith(" cm")
     landed = [Place("A", a), Push("paddle", (a[0], 8 / 2.54, 0.0), 1.0)]  # 0.5 cm into A
-    result = evaluate_plan(problem, landed, rollouts=1, workers=1, keep_records=True)
+    result = evaluate_plan(problem, landed, rollouts=1, runner=SERIAL, keep_records=True)
     assert result.failures.action_failures[0].reason == (
         "the push started with shapes overlapping (by more than 0.0508 cm)"
     )
@@ -176,7 +183,7 @@ def test_an_overlap_is_reported_in_the_files_length_unit():
 def test_off_table_and_not_at_rest_are_told_apart(monkeypatch):
     problem = _open_right()
     push_off = [Place("A", (8.0, 2.5, 0.0)), Push("paddle", (7.325, 2.5, EAST), 3.0)]
-    result = evaluate_plan(problem, push_off, rollouts=1, workers=1, keep_records=True)
+    result = evaluate_plan(problem, push_off, rollouts=1, runner=SERIAL, keep_records=True)
     assert result.failures.off_table == 1
     assert result.failures.off_table_actions[0][:2] == (1, "A")
     assert result.records[0].failure.kind == OFF_TABLE
@@ -192,7 +199,7 @@ def test_off_table_and_not_at_rest_are_told_apart(monkeypatch):
         return outcome
 
     monkeypatch.setattr(physics, "simulate", capped)
-    result = evaluate_plan(problem, push_off, rollouts=2, workers=1)
+    result = evaluate_plan(problem, push_off, rollouts=2, runner=SERIAL)
     assert result.failures.not_at_rest == 2
     assert result.failures.not_at_rest_actions[0] == (1, 2)
 
@@ -228,7 +235,7 @@ def test_bad_arguments_are_refused(blocks1):
     with pytest.raises(ValueError, match="seed"):
         evaluate_plan(problem, actions, seed=-1)
     with pytest.raises(ValueError, match="backend"):
-        evaluate_plan(problem, actions, backend="cloud")
+        evaluate_plan(problem, actions, runner=RunnerConfig(backend="cloud"))
     with pytest.raises(ValueError, match="no object 'Z'"):
         evaluate_plan(problem, [Place("Z", (1.0, 1.0, 0.0))], rollouts=1)
 
@@ -250,7 +257,13 @@ def test_an_interrupted_run_resumes_to_the_identical_result(blocks2, tmp_path):
 
     with pytest.raises(KeyboardInterrupt):
         evaluate_plan(
-            problem, actions, rollouts=30, seed=1, workers=1, record=record, progress=stop_after_7
+            problem,
+            actions,
+            rollouts=30,
+            seed=1,
+            runner=SERIAL,
+            record=record,
+            progress=stop_after_7,
         )
     lines = _lines(record)
     header = json.loads(lines[0])
@@ -258,12 +271,14 @@ def test_an_interrupted_run_resumes_to_the_identical_result(blocks2, tmp_path):
     assert [json.loads(line)["rollout"] for line in lines[1:]] == list(range(7))
     assert seen[0].done == 0 and seen[-1].done == 7
 
-    resumed = evaluate_plan(problem, actions, rollouts=30, seed=1, workers=2, record=record)
+    resumed = evaluate_plan(
+        problem, actions, rollouts=30, seed=1, runner=RunnerConfig(workers=2), record=record
+    )
     assert resumed.resumed == 7
-    straight = evaluate_plan(problem, actions, rollouts=30, seed=1, workers=1)
+    straight = evaluate_plan(problem, actions, rollouts=30, seed=1, runner=SERIAL)
     assert resumed == straight
     assert len(_lines(record)) == 31
-    again = evaluate_plan(problem, actions, rollouts=30, seed=1, workers=1, record=record)
+    again = evaluate_plan(problem, actions, rollouts=30, seed=1, runner=SERIAL, record=record)
     assert again == straight and again.resumed == 30 and len(_lines(record)) == 31
 
 
@@ -281,15 +296,17 @@ def test_an_interrupted_pool_run_keeps_its_records(blocks2, tmp_path):
             actions,
             rollouts=40,
             seed=2,
-            workers=2,
+            runner=RunnerConfig(workers=2),
             chunksize=3,
             record=record,
             progress=stop_after_9,
         )
     assert len(_lines(record)) - 1 >= 9
-    resumed = evaluate_plan(problem, actions, rollouts=40, seed=2, workers=2, record=record)
+    resumed = evaluate_plan(
+        problem, actions, rollouts=40, seed=2, runner=RunnerConfig(workers=2), record=record
+    )
     assert resumed.resumed >= 9
-    assert resumed == evaluate_plan(problem, actions, rollouts=40, seed=2, workers=1)
+    assert resumed == evaluate_plan(problem, actions, rollouts=40, seed=2, runner=SERIAL)
 
 
 def test_a_killed_process_loses_nothing_recorded(blocks1, tmp_path):
@@ -301,53 +318,54 @@ def test_a_killed_process_loses_nothing_recorded(blocks1, tmp_path):
         "import os, signal\n"
         "from arrange_up.io.domains import load\n"
         "from arrange_up.evaluation.evaluate import evaluate_plan\n"
+        "from arrange_up.parallel import SERIAL\n"
         "from arrange_up.planning.planner import plan\n"
         "p = load('blocks-1')\n"
         "a = plan(p, semantics='deterministic', seed=0).actions\n"
         "def kill(s):\n"
         "    if s.done == 5:\n"
         "        os.kill(os.getpid(), signal.SIGKILL)\n"
-        f"evaluate_plan(p, a, rollouts=12, workers=1, record={str(record)!r}, progress=kill)\n"
+        f"evaluate_plan(p, a, rollouts=12, runner=SERIAL, record={str(record)!r}, progress=kill)\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=120)
     assert done.returncode == -9, done.stderr
     assert len(_lines(record)) == 6
-    resumed = evaluate_plan(problem, actions, rollouts=12, workers=1, record=record)
+    resumed = evaluate_plan(problem, actions, rollouts=12, runner=SERIAL, record=record)
     assert resumed.resumed == 5
-    assert resumed == evaluate_plan(problem, actions, rollouts=12, workers=1)
+    assert resumed == evaluate_plan(problem, actions, rollouts=12, runner=SERIAL)
 
 
 def test_a_record_can_be_extended_and_a_cut_line_is_dropped(blocks1, tmp_path):
     problem, actions = blocks1
     record = tmp_path / "b1.jsonl"
-    evaluate_plan(problem, actions, rollouts=6, workers=1, record=record)
+    evaluate_plan(problem, actions, rollouts=6, runner=SERIAL, record=record)
     text = record.read_text()
     record.write_text(text + '{"rollout": 6, "succ')  # killed while writing a line
-    longer = evaluate_plan(problem, actions, rollouts=10, workers=1, record=record)
+    longer = evaluate_plan(problem, actions, rollouts=10, runner=SERIAL, record=record)
     assert longer.resumed == 6
-    assert longer == evaluate_plan(problem, actions, rollouts=10, workers=1)
+    assert longer == evaluate_plan(problem, actions, rollouts=10, runner=SERIAL)
     lines = _lines(record)
     assert len(lines) == 11 and all(json.loads(line) for line in lines)
-    shorter = evaluate_plan(problem, actions, rollouts=4, workers=1, record=record)
-    assert shorter == evaluate_plan(problem, actions, rollouts=4, workers=1)
+    shorter = evaluate_plan(problem, actions, rollouts=4, runner=SERIAL, record=record)
+    assert shorter == evaluate_plan(problem, actions, rollouts=4, runner=SERIAL)
 
 
 def test_a_record_of_another_evaluation_is_refused(blocks1, tmp_path):
     problem, actions = blocks1
     record = tmp_path / "r.jsonl"
-    evaluate_plan(problem, actions, rollouts=2, seed=0, workers=1, record=record)
+    evaluate_plan(problem, actions, rollouts=2, seed=0, runner=SERIAL, record=record)
     with pytest.raises(RecordFileError, match="seed: file 0, this run 1"):
-        evaluate_plan(problem, actions, rollouts=2, seed=1, workers=1, record=record)
+        evaluate_plan(problem, actions, rollouts=2, seed=1, runner=SERIAL, record=record)
     with pytest.raises(RecordFileError, match="plan.hash"):
-        evaluate_plan(problem, actions[:-1], rollouts=2, seed=0, workers=1, record=record)
+        evaluate_plan(problem, actions[:-1], rollouts=2, seed=0, runner=SERIAL, record=record)
     other = tmp_path / "other.jsonl"
     other.write_text('{"format": "something-else"}\n')
     with pytest.raises(RecordFileError, match="not an arrange-up rollout record"):
-        evaluate_plan(problem, actions, rollouts=2, workers=1, record=other)
+        evaluate_plan(problem, actions, rollouts=2, runner=SERIAL, record=other)
     lines = _lines(record)
     record.write_text("\n".join([lines[0], "{oops", *lines[1:]]) + "\n")
     with pytest.raises(RecordFileError, match=r"r\.jsonl:2: not a rollout record"):
-        evaluate_plan(problem, actions, rollouts=2, workers=1, record=record)
+        evaluate_plan(problem, actions, rollouts=2, runner=SERIAL, record=record)
 
 
 def test_a_file_that_is_not_a_record_is_refused_untouched_even_without_a_final_newline(
@@ -364,13 +382,13 @@ def test_a_file_that_is_not_a_record_is_refused_untouched_even_without_a_final_n
         path = tmp_path / name
         path.write_text(text)
         with pytest.raises(RecordFileError, match="not an arrange-up rollout record"):
-            evaluate_plan(problem, actions, rollouts=2, workers=1, record=path)
+            evaluate_plan(problem, actions, rollouts=2, runner=SERIAL, record=path)
         assert path.read_text() == text
     # the start of a header a kill cut off is a record begun: it starts afresh
     begun = tmp_path / "begun.jsonl"
     begun.write_text('{"format":"arrange-up-rol')
-    result = evaluate_plan(problem, actions, rollouts=2, workers=1, record=begun)
-    assert result == evaluate_plan(problem, actions, rollouts=2, workers=1)
+    result = evaluate_plan(problem, actions, rollouts=2, runner=SERIAL, record=begun)
+    assert result == evaluate_plan(problem, actions, rollouts=2, runner=SERIAL)
     assert len(_lines(begun)) == 3
 
 
@@ -380,14 +398,14 @@ def test_a_record_in_use_is_refused(blocks1, tmp_path):
     holder = _RecordFile(record, {"format": "arrange-up-rollouts/1"})
     try:
         with pytest.raises(RecordFileError, match="in use"):
-            evaluate_plan(problem, actions, rollouts=1, workers=1, record=record)
+            evaluate_plan(problem, actions, rollouts=1, runner=SERIAL, record=record)
     finally:
         holder.close()
 
 
 def test_records_round_trip_through_json(blocks2):
     problem, actions = blocks2
-    result = evaluate_plan(problem, actions, rollouts=8, workers=1, keep_records=True)
+    result = evaluate_plan(problem, actions, rollouts=8, runner=SERIAL, keep_records=True)
     for record in result.records:
         assert RolloutRecord.from_json(json.loads(json.dumps(record.to_json()))) == record
     kinds = {r.failure.kind for r in result.records if r.failure}
@@ -487,7 +505,7 @@ def test_the_reliability_validator(blocks1):
     for key in ("successes", "trials", "rate", "interval"):
         assert key in check.metrics
     assert check.metrics["trials"] == "10"
-    direct = evaluate_plan(problem, actions, rollouts=10, workers=1)
+    direct = evaluate_plan(problem, actions, rollouts=10, runner=SERIAL)
     assert check.metrics["successes"] == str(direct.successes)
     valid = direct.successes == 10
     assert (check.status is ValidationResultStatus.VALID) == valid

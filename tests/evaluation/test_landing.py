@@ -12,6 +12,7 @@ from arrange_up.evaluation.records import RecordFileError
 from arrange_up.evaluation.rollouts import PUSH_OVERLAP_REASON
 from arrange_up.io.domains import load
 from arrange_up.model.world import Place, Push
+from arrange_up.parallel import SERIAL
 
 EAST = -math.pi / 2.0  # the paddle pushes along +x
 # The paddle (0.15 in thick) put down 0.2 in inside block A's left face.
@@ -20,8 +21,8 @@ PLAN = [Place("A", (5.0, 2.5, 0.0)), Push("paddle", (4.7, 2.5, EAST), 1.0)]
 
 def test_fail_is_the_default_and_names_the_landing():
     problem = load("blocks-1")
-    result = evaluate_plan(problem, PLAN, rollouts=2, workers=1)
-    assert result == evaluate_plan(problem, PLAN, rollouts=2, workers=1, landing="fail")
+    result = evaluate_plan(problem, PLAN, rollouts=2, runner=SERIAL)
+    assert result == evaluate_plan(problem, PLAN, rollouts=2, runner=SERIAL, landing="fail")
     (failure,) = result.failures.action_failures
     assert (failure.action, failure.rollouts) == (1, 2)
     assert failure.reason.startswith(PUSH_OVERLAP_REASON)
@@ -30,7 +31,7 @@ def test_fail_is_the_default_and_names_the_landing():
 
 def test_shove_lets_the_physics_resolve_it():
     problem = load("blocks-1")
-    result = evaluate_plan(problem, PLAN, rollouts=2, workers=1, landing="shove")
+    result = evaluate_plan(problem, PLAN, rollouts=2, runner=SERIAL, landing="shove")
     assert result.failures.action_failed == 0
     assert result.to_json()["landing"] == "shove"
 
@@ -38,11 +39,11 @@ def test_shove_lets_the_physics_resolve_it():
 def test_landing_is_checked_and_part_of_the_record(tmp_path):
     problem = load("blocks-1")
     with pytest.raises(ValueError, match="unknown landing 'skip'"):
-        evaluate_plan(problem, PLAN, rollouts=1, workers=1, landing="skip")
+        evaluate_plan(problem, PLAN, rollouts=1, runner=SERIAL, landing="skip")
     record = tmp_path / "r.jsonl"
-    evaluate_plan(problem, PLAN, rollouts=1, workers=1, record=record)
+    evaluate_plan(problem, PLAN, rollouts=1, runner=SERIAL, record=record)
     with pytest.raises(RecordFileError):
-        evaluate_plan(problem, PLAN, rollouts=1, workers=1, record=record, landing="shove")
+        evaluate_plan(problem, PLAN, rollouts=1, runner=SERIAL, record=record, landing="shove")
 
 
 def test_cli_landing_option(tmp_path):

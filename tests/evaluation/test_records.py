@@ -12,6 +12,7 @@ from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.records import RECORD_FORMAT, RecordFile, RecordFileError
 from arrange_up.io.domains import load
 from arrange_up.model.world import Place
+from arrange_up.parallel import SERIAL
 
 HEADER = {
     "format": RECORD_FORMAT,
@@ -106,15 +107,15 @@ def test_a_resumed_evaluation_refuses_an_edited_line(tmp_path: Path):
     problem = load("blocks-1")
     actions = [Place("A", (9.5, 0.5, 0.0))]
     record = tmp_path / "b1.jsonl"
-    first = evaluate_plan(problem, actions, rollouts=3, seed=0, workers=1, record=record)
+    first = evaluate_plan(problem, actions, rollouts=3, seed=0, runner=SERIAL, record=record)
     lines = record.read_text().splitlines()
     edited = json.loads(lines[2])
     edited.update(success=False, failure={"kind": "action_failed", "action": 7})
     record.write_text("\n".join([*lines[:2], json.dumps(edited), *lines[3:]]) + "\n")
     with pytest.raises(RecordFileError, match=rf"{record.name}:3: .*action.*got 7"):
-        evaluate_plan(problem, actions, rollouts=3, seed=0, workers=1, record=record)
+        evaluate_plan(problem, actions, rollouts=3, seed=0, runner=SERIAL, record=record)
     record.write_text("\n".join(lines) + "\n")  # as written: resumed, identical
-    again = evaluate_plan(problem, actions, rollouts=3, seed=0, workers=1, record=record)
+    again = evaluate_plan(problem, actions, rollouts=3, seed=0, runner=SERIAL, record=record)
     assert again == first and again.resumed == 3
 
 

@@ -28,6 +28,7 @@ from arrange_up.experiments.planning import (
 from arrange_up.experiments.problems import physics_setting
 from arrange_up.io.domains import load
 from arrange_up.model.problem import SERVO_CONTROLLER, ControllerKind, driven_by
+from arrange_up.parallel import SERIAL
 from arrange_up.repair import nominal_plans
 
 SERVO_PROBLEM = driven_by(load("blocks-1"), "servo")
@@ -102,12 +103,12 @@ def test_the_fixture_experiment_repairs_under_the_controller(tmp_path, monkeypat
 
     monkeypatch.setattr(fixtures, "repair_plan", recording)
     args = {"problems": ("down-push",), "plans": 1, "particles": (3,), "rollouts": 0}
-    path = fixtures.fixture_experiment(tmp_path, workers=1, controller="servo", **args)
+    path = fixtures.fixture_experiment(tmp_path, runner=SERIAL, controller="servo", **args)
     assert seen == [ControllerKind.SERVO, ControllerKind.SERVO]  # the repair and its ablation
     assert {r["controller"] for r in read_csv(path)} == {"servo"}
     assert settings(path)["controller"] == "servo"
     with pytest.raises(CsvRecordsError, match="controller"):
-        fixtures.fixture_experiment(tmp_path, workers=1, **args)
+        fixtures.fixture_experiment(tmp_path, runner=SERIAL, **args)
 
 
 def test_the_cli_option_and_its_refusal(tmp_path):

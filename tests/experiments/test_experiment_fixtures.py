@@ -20,8 +20,9 @@ from arrange_up.experiments.fixtures import (
     summarize,
 )
 from arrange_up.io.domains import resolve_problem
+from arrange_up.parallel import SERIAL
 
-TINY = {"plans": 1, "particles": (3, 5), "rollouts": 5, "workers": 1, "ablation": False}
+TINY = {"plans": 1, "particles": (3, 5), "rollouts": 5, "runner": SERIAL, "ablation": False}
 
 
 def rows(path):

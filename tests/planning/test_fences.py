@@ -19,6 +19,7 @@ from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
 from arrange_up.io.yaml_problem import load_problem
 from arrange_up.model.problem import Uncertainty
 from arrange_up.model.world import Pick, Place, Push, WorldState
+from arrange_up.parallel import SERIAL
 from arrange_up.physics.stall import wall_overdrive, wall_push_front
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.transitions import make_semantics
@@ -272,7 +273,7 @@ def test_the_planner_builds_its_own_fence_and_its_plan_reaches_the_goal_in_rollo
     write_json_atomic(path, document)
     actions, read = read_plan(path, corner)
     assert actions == result.actions and read["status"] == "solved"
-    reliability = evaluate_plan(corner, result.actions, rollouts=40, seed=0, workers=1)
+    reliability = evaluate_plan(corner, result.actions, rollouts=40, seed=0, runner=SERIAL)
     assert reliability.successes >= FLOORS[semantics], reliability.failures
 
 

@@ -10,9 +10,9 @@ import pytest
 from catalogue import tiny, with_planning
 
 import arrange_up
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.goals import GoalTest
 from arrange_up.belief.states import AngleFrame, ParticleBelief
-from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.model.world import WorldState
 from arrange_up.planning.actions import ActionGenerator
 from arrange_up.planning.heuristics import HEURISTICS, make_heuristic, per_dimension_count
@@ -21,9 +21,9 @@ PARTICLES = 5
 
 
 def heuristic(name: str, problem, *, with_generator: bool = True):
-    checker = CollisionChecker(problem)
-    generator = ActionGenerator(problem, checker) if with_generator else None
-    return make_heuristic(name, problem, GoalTest(problem), checker, generator)
+    compiled = compile_problem(problem)
+    generator = ActionGenerator(problem, compiled.checker) if with_generator else None
+    return make_heuristic(name, compiled, generator)
 
 
 def particles(problem, jitter: float = 0.0, seed: int = 0, **poses) -> ParticleBelief:
@@ -176,10 +176,7 @@ def test_per_dimension_count_of_a_relative_goal_needs_the_reference():
 
 # -- the ordering filter -------------------------------------------------------------------
 def test_ordering_filter_flags_reversed_row():
-    p = tiny("two-blocks-row")
-    checker = CollisionChecker(p)
-    goal = GoalTest(p)
-    h = make_heuristic("inadmissible", p, goal, checker)
+    h = make_heuristic("inadmissible", compile_problem(tiny("two-blocks-row")))
     # Goal: B left of A on the bottom row. Reversed in the same row -> infinite.
     reversed_row = ParticleBelief((WorldState((("A", (6.0, 1.0, 0.0)), ("B", (8.0, 1.0, 0.0)))),))
     assert h(reversed_row) == math.inf

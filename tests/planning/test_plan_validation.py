@@ -16,6 +16,7 @@ from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.rollouts import rollout_start, trace_rollout
 from arrange_up.io.domains import load
 from arrange_up.io.yaml_problem import load_problem
+from arrange_up.parallel import SERIAL
 from arrange_up.planning import validation as validation_module
 from arrange_up.planning.planner import plan
 from arrange_up.planning.validation import (
@@ -47,7 +48,7 @@ def test_the_starts_of_failed_validation_rollouts_join_the_next_search(narrow) -
     assert (first.particles, first.expanded) == (2, unvalidated.stats["expanded"])
     seed = validation_seed(0, 0)
     check = evaluate_plan(
-        narrow, unvalidated.actions, rollouts=10, seed=seed, workers=1, keep_records=True
+        narrow, unvalidated.actions, rollouts=10, seed=seed, runner=SERIAL, keep_records=True
     )
     assert first.successes == check.successes < 10
     failed = [rollout_start(narrow, seed, r.index) for r in check.records if not r.success]
@@ -220,7 +221,9 @@ def test_a_stop_request_keeps_the_plan_and_the_rollouts_already_run(narrow, monk
     # one search, four rollouts: the stop is not mistaken for a failed validation to search on
     assert result.solved and len(validation.rounds) == 1
     assert (validation.run, validation.rollouts, validation.stopped_by) == (4, 10, "a stop request")
-    check = evaluate_plan(narrow, result.actions, rollouts=4, seed=validation_seed(0, 0), workers=1)
+    check = evaluate_plan(
+        narrow, result.actions, rollouts=4, seed=validation_seed(0, 0), runner=SERIAL
+    )
     assert validation.successes == check.successes
     assert "validated on 4 of 10 fresh rollouts (stopped by a stop request)" in validation.line()
 

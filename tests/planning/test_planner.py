@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from catalogue import particle_task, servo, tiny
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.belief.goals import GoalTest
 from arrange_up.io.domains import load
 from arrange_up.io.planfile import plan_document, read_plan, write_json_atomic
@@ -129,7 +130,7 @@ def test_status_and_statistics_are_typed_and_serialise_as_before(blocks2):
 
 
 def test_the_task_answers_what_the_search_asks_and_closes_its_semantics(blocks2):
-    task = BeliefTask.build(blocks2, PlanConfig(particles=3, seed=0))
+    task = BeliefTask.build(compile_problem(blocks2), PlanConfig(particles=3, seed=0))
     try:
         start = task.initial_belief()
         assert not task.is_goal(start) and task.heuristic(start) > 0
