@@ -194,6 +194,7 @@ class _OrderingFilter:
         self._blocking: dict[tuple, frozenset[int]] = {}
         self._pairs_blocking = None
         #: What a pair's blocking table depends on besides the pair and its targets.
+        problem = compiled.problem
         self._world = (
             problem.table,
             problem.objects,
