@@ -52,6 +52,14 @@ model trained on the planner's pushes to the wall (its card's ``wall_push`` is `
 (:data:`TRAINED_PUSH_REFUSAL`): such a model knows that push only.
 ``reasons`` counts the reasons, for diagnostics.
 
+Where the problem's controller has a **simulated fallback** (:data:`FALLBACK_PARTICLES`: the
+compliant controller's), such a push is not refused but answered by the physics
+(:class:`~arrange_up.transitions.fallback.SimulatedFallback`: states drawn from the interval
+belief, pushed, the boxes rebuilt from their ends); it is refused only when the physics refuses
+it too (a part pushed off the table, a simulation not at rest), under the physics' reason.
+``fallback_reasons`` counts why the model refused the pushes that fell back, and
+:meth:`CBSTSemantics.fallback_counts` how many fell back of all the pushes asked for.
+
 ``simulations`` counts model predictions: one per feature row evaluated (one PREDICT of the
 thesis; an object with several certain neighbours on either side takes one per pair).
 """
