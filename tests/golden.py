@@ -147,8 +147,8 @@ for _servo, _prefix in ((False, ""), (True, "servo-")):
     CASES[f"{_prefix}evaluate-blocks-4-p10-s0"] = _evaluation_case(
         "blocks-4", "particles", 10, 0, _servo
     )
-    # Under the compliant controller the CBST cases pin one plan (blocks-2) and three exhausted
-    # searches (docs/cbst.md), so only the servo's blocks-4 plan is evaluated.
+    # The servo's blocks-4 CBST plan is evaluated; the compliant CBST plans (the model's
+    # predictions and the simulated fallback's, docs/cbst.md) are pinned by the cases above.
     if _servo:
         CASES[f"{_prefix}evaluate-blocks-4-cbst"] = _evaluation_case(
             "blocks-4", "cbst", 1, 0, _servo

@@ -265,6 +265,8 @@ def plan(
             f"generated {stats['generated']}, "
             f"transitions simulated {stats['transitions_simulated']}"
         )
+        if result.fallbacks is not None:
+            click.echo(result.fallback_line())
         if result.agenda is not None:
             click.echo(result.agenda.line())
         if result.reason is not None:

@@ -154,6 +154,10 @@ class PlanResult:
     search's start but no place candidate there, every one failing the place precondition
     (their shadow must keep clear of walls, obstacles and the parts on the table: a part that
     fits its goal only touching them is never placed).
+    ``fallbacks`` (None for a semantics without a fallback): ``(fell back, pushes)``, the push
+    transitions a learned semantics answered by simulation where its model refused (CBST's
+    simulated fallback, :mod:`arrange_up.transitions.fallback`) and all the push transitions
+    it was asked for (its ``fallback_counts``).
     ``agenda`` (None when the run searched the whole goal only): what the goal agenda did and
     which search found the plan (:class:`~arrange_up.planning.agenda.AgendaRecord`).
     ``validation`` (None when the plan was not validated): how the plan, and each search, did
@@ -176,6 +180,7 @@ class PlanResult:
     unplaceable: tuple[str, ...] = ()
     unfit: tuple[str, ...] = ()
     agenda: AgendaRecord | None = None
+    fallbacks: tuple[int, int] | None = None
 
     @property
     def solved(self) -> bool:
@@ -186,14 +191,27 @@ class PlanResult:
         refusals of the ``earlier`` searches added, and the run's node limit ``max_nodes``."""
         statistics = self.statistics
         refusals = Counter(dict(self.refusals))
+        fallbacks = self.fallbacks
         for result in earlier:
             statistics = statistics.plus(result.statistics)
             refusals.update(dict(result.refusals))
+            if result.fallbacks is not None:
+                fell, pushes = fallbacks or (0, 0)
+                fallbacks = (fell + result.fallbacks[0], pushes + result.fallbacks[1])
         return dataclasses.replace(
             self,
             statistics=dataclasses.replace(statistics, max_nodes=max_nodes),
             refusals=tuple(refusals.most_common()),
+            fallbacks=fallbacks,
         )
+
+    def fallback_line(self) -> str | None:
+        """One line on the simulated fallback (None without one): how many push transitions
+        fell back to simulation, of how many."""
+        if self.fallbacks is None:
+            return None
+        fell, pushes = self.fallbacks
+        return f"simulated fallback: {fell} of {pushes} push transitions fell back to the physics"
 
     @property
     def reason(self) -> str | None:
@@ -552,7 +570,15 @@ def _search(
         refusals=tuple(evaluator.reasons.most_common()),
         unplaceable=_unplaceable(task, start_belief, misses),
         unfit=tuple(u.why for u in unfit),
+        fallbacks=_fallback_counts(task.semantics),
     )
+
+
+def _fallback_counts(semantics: Any) -> tuple[int, int] | None:
+    """:attr:`PlanResult.fallbacks` of ``semantics``: its ``fallback_counts()``, None for a
+    semantics without one."""
+    counts = getattr(semantics, "fallback_counts", None)
+    return None if counts is None else counts()
 
 
 def _misses(

@@ -52,6 +52,14 @@ model trained on the planner's pushes to the wall (its card's ``wall_push`` is `
 (:data:`TRAINED_PUSH_REFUSAL`): such a model knows that push only.
 ``reasons`` counts the reasons, for diagnostics.
 
+Where the problem's controller has a **simulated fallback** (:data:`FALLBACK_PARTICLES`: the
+compliant controller's), such a push is not refused but answered by the physics
+(:class:`~arrange_up.transitions.fallback.SimulatedFallback`: states drawn from the interval
+belief, pushed, the boxes rebuilt from their ends); it is refused only when the physics refuses
+it too (a part pushed off the table, a simulation not at rest), under the physics' reason.
+``fallback_reasons`` counts why the model refused the pushes that fell back, and
+:meth:`CBSTSemantics.fallback_counts` how many fell back of all the pushes asked for.
+
 ``simulations`` counts model predictions: one per feature row evaluated (one PREDICT of the
 thesis; an object with several certain neighbours on either side takes one per pair).
 """
@@ -91,8 +99,9 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.world import Action, Pick, Place, Push
 from arrange_up.physics.stall import wall_overdrive, wall_push_front
+from arrange_up.transitions.fallback import SimulatedFallback
 
-__all__ = ["GRAZE_ALLOWANCE", "CBSTSemantics"]
+__all__ = ["FALLBACK_PARTICLES", "GRAZE_ALLOWANCE", "CBSTSemantics"]
 
 #: Why a push towards a fixture has no prediction when the fixture cannot stand in for a wall.
 FIXTURE_REFUSAL = "a pushed object may slip past the end of a fixture ahead"
@@ -124,6 +133,16 @@ TRAINED_PUSH_TOLERANCE = 1e-3
 GRAZE_ALLOWANCE: dict[ControllerKind, float] = {
     ControllerKind.COMPLIANT: 0.09,
     ControllerKind.SERVO: 0.12,
+}
+
+#: States the simulated fallback draws from the interval belief of a push the model refuses
+#: (:mod:`arrange_up.transitions.fallback`), per controller kind; 0: no fallback, the push is
+#: refused. The servo's model predicts the pushes its plans need (docs/cbst.md), and its plans
+#: stay the model's; the compliant model refuses pushes the compliant plans need (its training
+#: domain, pushes that stop short, trains that may slide), so the physics answers them.
+FALLBACK_PARTICLES: dict[ControllerKind, int] = {
+    ControllerKind.COMPLIANT: 8,
+    ControllerKind.SERVO: 0,
 }
 
 #: What a predictable push does (:meth:`CBSTSemantics._outcome`): the reason it has no
@@ -175,6 +194,18 @@ class CBSTSemantics:
         self._outcomes: dict[tuple, tuple[PushStructure, _Outcome]] = {}
         self.reasons: Counter[str] = Counter()
         self.model = model_for(problem, model)  # trained under the problem's controller
+        fallback_particles = FALLBACK_PARTICLES[problem.controller.kind]
+        self.fallback = (
+            SimulatedFallback(problem, particles=fallback_particles, seed=seed)
+            if fallback_particles
+            else None
+        )
+        #: Push transitions asked for, and those the simulated fallback answered.
+        self.pushes = 0
+        self.fallbacks = 0
+        #: Why the model refused the pushes the fallback was asked for (answered or not), as
+        #: :attr:`reasons` counts the refusals.
+        self.fallback_reasons: Counter[str] = Counter()
         self.graze_allowance = GRAZE_ALLOWANCE[problem.controller.kind]
         card = self.model.card_
         self.block_size = float(card["block_size"])
@@ -236,6 +267,7 @@ class CBSTSemantics:
 
     def apply(self, belief: IntervalBelief, action: Action) -> IntervalBelief | None:
         if isinstance(action, Push):
+            self.pushes += 1
             return self._push(belief, action)
         objects = dict(belief.objects)
         if isinstance(action, Place):
@@ -248,16 +280,41 @@ class CBSTSemantics:
             raise TypeError(f"not an action: {action!r}")
         return self._belief(objects)
 
+    def fallback_counts(self) -> tuple[int, int] | None:
+        """``(fell back, pushes)``: the push transitions the simulated fallback answered and
+        all those asked for; None where this controller has no fallback
+        (:data:`FALLBACK_PARTICLES`)."""
+        return None if self.fallback is None else (self.fallbacks, self.pushes)
+
     def _refuse(self, reason: str) -> None:
         self.reasons[reason] += 1
         return None
+
+    def _fall_back(self, belief: IntervalBelief, push: Push, reason: str) -> IntervalBelief | None:
+        """The belief after ``push``, which the model refused for ``reason``: from the
+        simulated fallback (:mod:`arrange_up.transitions.fallback`) where this controller has
+        one, else None with ``reason`` counted. A push the physics refuses too is counted
+        under the physics' reason."""
+        if self.fallback is None:
+            return self._refuse(reason)
+        self.fallback_reasons[reason] += 1
+        before = self.fallback.simulations
+        answer = self.fallback.push(belief, push)
+        self.simulations += self.fallback.simulations - before
+        if isinstance(answer, str):
+            return self._refuse(answer)
+        self.fallbacks += 1
+        objects = dict(belief.objects)
+        for name, interval in answer.items():
+            objects[name] = self._interval(name, interval.center, interval.half)
+        return self._belief(objects)
 
     # -- push ---------------------------------------------------------------------------------
     def _push(self, belief: IntervalBelief, push: Push) -> IntervalBelief | None:
         problem = self.problem
         frame, paddle = self._paddle(push)
         if frame is None or paddle is None:
-            return self._refuse("the push is not axis-aligned")
+            return self._fall_back(belief, push, "the push is not axis-aligned")
         d = self.block_size
         nodes = self._nodes_of(belief, frame)
         table = frame.table_box(problem.table.size)
@@ -282,11 +339,11 @@ class CBSTSemantics:
                 by[m.name].center[1] - 0.25 * d < box[1] or by[m.name].center[1] + 0.25 * d > box[3]
                 for m in structure.members
             ):
-                return self._refuse(FIXTURE_REFUSAL)
+                return self._fall_back(belief, push, FIXTURE_REFUSAL)
         if structure.kind == "unchanged":
             return belief
         if structure.kind == "none":
-            return self._refuse(structure.reason)
+            return self._fall_back(belief, push, structure.reason)
         # The outcome depends on the push, the structure and its members' nodes (which the
         # memo's structure stands for), and on a fence's pose: remembered without a fence.
         key = (push, id(structure)) if fence is None else None
@@ -302,7 +359,7 @@ class CBSTSemantics:
         refusal, updates, simulated = outcome
         self.simulations += simulated
         if refusal is not None:
-            return self._refuse(refusal)
+            return self._fall_back(belief, push, refusal)
         objects = dict(belief.objects)
         objects.update(updates)
         return self._belief(objects)

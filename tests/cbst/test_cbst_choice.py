@@ -258,12 +258,14 @@ def test_a_model_of_the_planners_wall_pushes_predicts_those_pushes_only(tmp_path
 
     planner = CBSTSemantics(problem, model=tmp_path / "planner" / "compliant.json")
     assert planner.apply(belief, wall_push(compressed=True)) is not None
-    assert planner.apply(belief, wall_push(compressed=False)) is None
-    assert planner.reasons == {TRAINED_PUSH_REFUSAL: 1}
+    # the model refuses the other push, which the simulated fallback answers
+    assert planner.apply(belief, wall_push(compressed=False)) is not None
+    assert planner.fallback_reasons == {TRAINED_PUSH_REFUSAL: 1}
+    assert planner.fallback_counts() == (1, 2)
     assert tiny("uniform")["data"]["settings"]["wall_push"] == "uniform"
     uniform = CBSTSemantics(problem, model=tmp_path / "uniform" / "compliant.json")
     uniform.apply(belief, wall_push(compressed=False))
-    assert TRAINED_PUSH_REFUSAL not in uniform.reasons
+    assert TRAINED_PUSH_REFUSAL not in uniform.reasons + uniform.fallback_reasons
 
 
 def test_the_shipped_compliant_model_learnt_the_planners_wall_pushes():

@@ -1,0 +1,56 @@
+"""Compliant CBST with its simulated fallback: what it plans, at what cost, how reliably.
+
+Usage::
+
+    python benchmarks/cbst_fallback.py [--problems blocks-2,blocks-3,...] [--rollouts 1000]
+
+Plans each shipped problem under its own (compliant) controller with ``semantics="cbst"``
+(the shipped model, seed 0, one worker, the goal agenda, no validation) and prints one row per
+problem: status, nodes expanded, the search's CPU seconds (``time.process_time`` of this
+process, where CBST and its fallback run), the push transitions that fell back to the physics
+of all asked for, and the plan's reliability on ``--rollouts`` rollouts (seed 0, one worker,
+in this process). Written for issue 33's targets: see docs/cbst.md, "The simulated fallback".
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.io.domains import load
+from arrange_up.planning.planner import plan
+
+PROBLEMS = ("blocks-2", "blocks-3", "blocks-4", "blocks-7", "blocks-9", "blocks-9-square")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--problems", default=",".join(PROBLEMS), help="comma-separated names")
+    parser.add_argument(
+        "--rollouts", type=int, default=1000, help="rollouts per plan (default: %(default)s)"
+    )
+    args = parser.parse_args()
+    print("problem          status     nodes  CPU s  fallbacks         reliability")
+    for name in args.problems.split(","):
+        problem = load(name)
+        started = time.process_time()
+        result = plan(problem, semantics="cbst", workers=1, validate=0)
+        seconds = time.process_time() - started
+        fell, pushes = result.fallbacks or (0, 0)
+        share = f"{fell}/{pushes} ({fell / pushes:.0%})" if pushes else "-"
+        reliability = "-"
+        if result.actions is not None:
+            score = evaluate_plan(
+                problem, result.actions, rollouts=args.rollouts, seed=0, workers=1
+            )
+            reliability = f"{score.successes}/{score.trials}"
+        print(
+            f"{name:<16} {result.status:<10} {result.stats['expanded']:>5} {seconds:>6.1f}  "
+            f"{share:<17} {reliability}",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
