@@ -85,8 +85,8 @@ def test_a_replan_without_a_plan_is_recorded_and_the_last_plan_found_returned(na
 
 
 def test_a_search_after_the_first_is_limited_to_a_few_times_its_nodes() -> None:
-    assert research_budget(10, 5000) == 200  # the floor
-    assert research_budget(100, 5000) == 400  # four times the first search's nodes
+    assert research_budget(10, 5000) == 1000  # the floor
+    assert research_budget(300, 5000) == 3000  # ten times the first search's nodes
     assert research_budget(3000, 5000) == 5000  # never beyond the run's limit
     assert research_budget(10, 50) == 50
 
