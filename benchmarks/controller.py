@@ -56,7 +56,12 @@ from arrange_up.model.problem import (
 )
 from arrange_up.model.world import Push, WorldState, draw_noise
 from arrange_up.physics.bench import scene
-from arrange_up.physics.simulation import DEFAULT_SETTINGS, simulate, simulate_watched
+from arrange_up.physics.simulation import (
+    DEFAULT_SETTINGS,
+    PhysicsSettings,
+    simulate,
+    simulate_watched,
+)
 from arrange_up.planning.planner import plan
 
 DISTANCES = (0.5, 1.0, 2.0, 5.0)
@@ -111,7 +116,11 @@ class Watch:
 
 
 def _push_with(
-    problem: ArrangementProblem, state: WorldState, push: Push, rng: np.random.Generator
+    problem: ArrangementProblem,
+    state: WorldState,
+    push: Push,
+    rng: np.random.Generator,
+    settings: PhysicsSettings = DEFAULT_SETTINGS,
 ):
     noise = draw_noise(problem, push, rng)
     px, py, pth = push.pose
@@ -119,7 +128,7 @@ def _push_with(
     start = (px + ox, py + oy)
     direction = (-math.sin(pth + oth), math.cos(pth + oth))  # the paddle's +y
     watch = Watch(start, direction)
-    outcome = simulate_watched(problem, state, push, watch, noise)
+    outcome = simulate_watched(problem, state, push, watch, noise, settings)
     return outcome, noise, watch
 
 
@@ -130,9 +139,13 @@ def _row_state(problem: ArrangementProblem, count: int) -> tuple[WorldState, Pus
     return state, Push("paddle", (2.0 - 0.5 - 0.075 - 0.1, y, -math.pi / 2.0), 3.0)
 
 
-def measure(controller: Controller, pushes: int, seed: int) -> dict:
+def measure(
+    controller: Controller, pushes: int, seed: int, settings: PhysicsSettings = DEFAULT_SETTINGS
+) -> dict:
+    """The :data:`FIELDS` but ``controller`` and ``kp`` of ``controller`` under ``settings``,
+    over ``pushes`` pushes of each scene (module docstring)."""
     rng = np.random.default_rng(seed)
-    step = DEFAULT_SETTINGS.dt
+    step = settings.dt
     speeds = {"block": 0.0, "paddle": 0.0}
     not_ok = 0
 
@@ -152,7 +165,9 @@ def measure(controller: Controller, pushes: int, seed: int) -> dict:
     end_errors, overshoots = [], []
     for i in range(pushes):
         d = DISTANCES[i % len(DISTANCES)]
-        outcome, _, watch = _push_with(problem, WorldState(()), replace(push, distance=d), rng)
+        outcome, _, watch = _push_with(
+            problem, WorldState(()), replace(push, distance=d), rng, settings
+        )
         note(watch, outcome)
         end_errors.append(outcome.manipulator_travel - d)
         overshoots.append(max(0.0, watch.furthest - d))
@@ -163,7 +178,7 @@ def measure(controller: Controller, pushes: int, seed: int) -> dict:
     stalls, loads, thrown = [], [], []
     for i in range(pushes):
         d = DISTANCES[i % len(DISTANCES)]
-        outcome, noise, watch = _push_with(problem, state, replace(push, distance=d), rng)
+        outcome, noise, watch = _push_with(problem, state, replace(push, distance=d), rng, settings)
         note(watch, outcome)
         stalls.append(d - outcome.manipulator_travel)
         loads.append(noise.friction * noise.part_density * 1.0)  # block area 1 in^2
@@ -186,7 +201,7 @@ def measure(controller: Controller, pushes: int, seed: int) -> dict:
     state, push = _row_state(problem, 4)
     scattered = 0
     for _ in range(pushes):
-        outcome, _, watch = _push_with(problem, state, push, rng)
+        outcome, _, watch = _push_with(problem, state, push, rng, settings)
         note(watch, outcome)
         xs = [p[0] for _, p in outcome.state.poses]
         ys = [p[1] for _, p in outcome.state.poses]
@@ -199,7 +214,7 @@ def measure(controller: Controller, pushes: int, seed: int) -> dict:
     wall = -math.inf
     for i in range(pushes):
         d = (2.5, 5.0)[i % 2]
-        outcome, _, watch = _push_with(problem, state, replace(push, distance=d), rng)
+        outcome, _, watch = _push_with(problem, state, replace(push, distance=d), rng, settings)
         note(watch, outcome)
         wall = max(wall, watch.wall)
 

@@ -80,8 +80,11 @@ def parse_case(case: str) -> tuple[str, str]:
     return problem, particles
 
 
-def child(problem_name: str, particles: str, seed: int, config: str) -> None:
-    """One planning run in this process (the code on ``PYTHONPATH``); prints a JSON row."""
+def child(
+    problem_name: str, particles: str, seed: int, config: str, validated: bool = False
+) -> None:
+    """One planning run in this process (the code on ``PYTHONPATH``); prints a JSON row. With
+    ``validated``, the code's own validation of particle plans is left on."""
     import arrange_up
     from arrange_up.model.problem import driven_by
     from arrange_up.planning.planner import plan
@@ -109,7 +112,7 @@ def child(problem_name: str, particles: str, seed: int, config: str) -> None:
         begin = time.perf_counter()
         get_runner(backend, int(workers))
         startup = time.perf_counter() - begin
-    if "validate" in inspect.signature(plan).parameters:
+    if "validate" in inspect.signature(plan).parameters and not validated:
         options["validate"] = 0  # the search alone (module docstring)
     start, cpu = time.perf_counter(), time.process_time()
     result = plan(problem, seed=seed, **options)
@@ -148,10 +151,12 @@ def checkout(ref: str, into: Path) -> Path:
     return tree
 
 
-def run(code_root: Path, case: tuple[str, str], config: str, seed: int) -> dict:
+def run(
+    code_root: Path, case: tuple[str, str], config: str, seed: int, validated: bool = False
+) -> dict:
     env = {**os.environ, "PYTHONPATH": str(code_root)}
     command = [sys.executable, str(Path(__file__).resolve()), "--child"]
-    command += [f"{case[0]}:{case[1]}", config, str(seed)]
+    command += [f"{case[0]}:{case[1]}", config, str(seed)] + (["validated"] if validated else [])
     done = subprocess.run(command, env=env, capture_output=True, text=True, cwd=code_root)
     if done.returncode != 0:
         raise SystemExit(f"run {case} {config} at {code_root} failed:\n{done.stderr}")
@@ -190,11 +195,16 @@ def main() -> None:
         default=Path("planning-bench.csv"),
         help="CSV the rows are appended to as they are measured (default: %(default)s)",
     )
-    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--validated",
+        action="store_true",
+        help="leave the code's validation of particle plans on (default: the search alone)",
+    )
+    parser.add_argument("--child", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         name, particles = parse_case(args.child[0])
-        child(name, particles, int(args.child[2]), args.child[1])
+        child(name, particles, int(args.child[2]), args.child[1], args.child[3:] == ["validated"])
         return
 
     cases = [parse_case(c) for c in args.cases.split(",")]
@@ -219,7 +229,7 @@ def main() -> None:
                         for code in order:
                             if code == "old" and not config.startswith("local:"):
                                 continue
-                            row = run(codes[code], case, config, args.seed)
+                            row = run(codes[code], case, config, args.seed, args.validated)
                             first_hash = first_hash or row["plan_hash"]
                             row.update(
                                 code=code,

@@ -34,6 +34,13 @@ and approach offset per push, from ``--seed``):
   it, the bar picked, the T pushed onto the Z);
 * the L part of ``tests/catalogue.py`` pushed 3.5 in into its board's right wall.
 
+``--versus KEY=VALUE ...`` adds a third setting, the defaults with those overrides (for
+example ``compliant_in_solver=true``), to the summary. ``--behaviour N`` reports instead the
+compliant controller's behaviour under the reference, old, new (and versus) settings on ``N``
+pushes of each scene of ``benchmarks/controller.py``: free pushes' end error and overshoot, the
+stall of a block pushed across the open table and its correlation with friction x mass, blocks
+thrown ahead of the paddle, rows scattered, the deepest a block went into the wall.
+
 ``--alternatives`` prints the same summary for each alternative of :data:`ALTERNATIVES` (the
 table of ``docs/design/physics.md``) instead. ``--rollouts N`` measures rollouts per second of
 evaluation under old and new settings, paired (alternating rounds in one process, medians): the
@@ -465,6 +472,38 @@ def success_counts(n: int, seed: int, new: PhysicsSettings) -> None:
         print(f"{case:<28} {wins_old:>5}/{n:<3} {wins_new:>5}/{n:<3} {same:>8}/{n}")
 
 
+#: The behaviour :func:`behaviour` reports, from ``benchmarks/controller.py``'s measures.
+BEHAVIOUR = (
+    ("free_end_error_max", "free end err", ".4f"),
+    ("free_overshoot_max", "overshoot", ".4f"),
+    ("resisted_stall_median", "stall med", ".4f"),
+    ("stall_vs_friction_mass_r", "stall r", ".2f"),
+    ("thrown_max", "thrown", ".4f"),
+    ("row_scattered", "scattered", "d"),
+    ("wall_penetration_max", "wall depth", ".4f"),
+    ("not_ok", "not ok", "d"),
+)
+
+
+def behaviour(settings: dict[str, PhysicsSettings], pushes: int, seed: int) -> None:
+    """The compliant controller's behaviour under each of ``settings`` and the reference, on
+    the scenes of ``benchmarks/controller.py`` (the same ``pushes`` noisy pushes of each):
+    the free paddle's largest end error and overshoot past its target, the median stall of a
+    lone block pushed across the open table and its correlation with friction x the block's
+    mass, the largest gap a block was thrown ahead of the paddle, the gathered rows of four
+    scattered, the deepest any block went into the wall (its slop allows about 0.005 in) and
+    the pushes not ``OK``."""
+    from controller import measure  # noqa: PLC0415 - the sibling benchmark, on this path
+
+    controller = load("blocks-7").controller
+    print(f"behaviour, compliant controller, {pushes} pushes per scene (seed {seed})")
+    print(f"  {'setting':<10}" + "".join(f" {title:>12}" for _, title, _ in BEHAVIOUR))
+    for label, s in {"reference": REFERENCE, **settings}.items():
+        row = measure(controller, pushes, seed, s)
+        cells = "".join(f" {format(row[key], fmt):>12}" for key, _, fmt in BEHAVIOUR)
+        print(f"  {label:<10}{cells}")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -492,6 +531,23 @@ def main() -> int:
         default=None,
         help="PhysicsSettings fields overriding the new settings' defaults, e.g. dt=1/480 "
         "iterations=20 (numbers, fractions, true or false; default: none)",
+    )
+    parser.add_argument(
+        "--versus",
+        nargs="*",
+        metavar="KEY=VALUE",
+        default=None,
+        help="also measure a third setting, 'versus': the defaults with these overrides, e.g. "
+        "compliant_in_solver=false (default: none)",
+    )
+    parser.add_argument(
+        "--behaviour",
+        type=int,
+        default=None,
+        metavar="N",
+        help="instead, report the compliant controller's behaviour (free overshoot, stall and "
+        "its correlation with friction x mass, thrown blocks, wall depth) under reference, old, "
+        "new and versus settings, N pushes per scene (default: off)",
     )
     parser.add_argument(
         "--alternatives",
@@ -557,6 +613,13 @@ def main() -> int:
         if args.evaluate is not None:
             success_counts(args.evaluate, args.seed, new)
         return 0
+    if args.behaviour is not None:
+        new = DEFAULT_SETTINGS.for_controller(ControllerKind.COMPLIANT)
+        settings = {"old": OLD, "new": replace(new, **_overrides(args.new or ()))}
+        if args.versus is not None:
+            settings["versus"] = replace(new, **_overrides(args.versus))
+        behaviour(settings, args.behaviour, args.seed)
+        return 0
     all_rows = []
     print(f"reference: {_settings_record(REFERENCE)}")
     print(f"old: {_settings_record(OLD)}")
@@ -570,6 +633,12 @@ def main() -> int:
                 new = replace(new, **_overrides(args.new))
             print(f"new ({name}): {_settings_record(new)}")
             settings = {"old": OLD, "new": new}
+            if args.versus is not None:
+                versus = replace(
+                    DEFAULT_SETTINGS.for_controller(controller), **_overrides(args.versus)
+                )
+                print(f"versus ({name}): {_settings_record(versus)}")
+                settings["versus"] = versus
         rows = measure(controller, settings, args.draws, args.seed, args.repeat)
         _print_summaries(name, rows, list(settings))
         all_rows += rows

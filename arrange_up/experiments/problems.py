@@ -36,7 +36,7 @@ def controller_setting(problems: Mapping[str, ArrangementProblem]) -> str:
 #: Settings added after CSVs were first recorded, with the value that turns them off: left out
 #: of the record when off, so that the rows of a controller whose physics they did not change
 #: (the servo has no stall window) still resume.
-_LATER_SETTINGS_OFF: dict[str, Any] = {"stall_window": 0.0}
+_LATER_SETTINGS_OFF: dict[str, Any] = {"stall_window": 0.0, "compliant_in_solver": False}
 
 
 def physics_setting(problems: Mapping[str, ArrangementProblem]) -> dict[str, dict[str, Any]]:

@@ -111,6 +111,10 @@ class PhysicsSettings:
     overlap_tolerance: float = 0.02
     """Deepest overlap between shapes (in) accepted when the push starts; deeper gives
     ``OVERLAP`` (overlapping bodies drift apart for seconds and the result means little)."""
+    compliant_in_solver: bool = False
+    """Run the compliant controller inside the engine's solver (springs and dampers on a
+    set-point body, :mod:`arrange_up.physics.simulation`) rather than as a force set from
+    Python before every step. The choice and its measurements: ``docs/design/physics.md``."""
 
     def __post_init__(self) -> None:
         positive = (

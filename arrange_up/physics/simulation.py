@@ -129,7 +129,9 @@ clipped at ``force`` and ``torque``: the brake) until the other bodies are at re
 low gain a resisted push stops short by about the resisting friction / Kp, growing with friction
 x mass; a free push ends at its target without overshoot (semi-implicit Euler of a critically
 damped PD at ``sqrt(Kp / m) dt`` ~ 0.19). Defaults (``Kp = 300``) and their measurements:
-``docs/design/physics.md``.
+``docs/design/physics.md``. With ``PhysicsSettings.compliant_in_solver`` the same PD, set point
+and clips are built from constraints the engine solves (:class:`_SolverTracking`), not set from
+Python before every step.
 
 Rest
 ====
@@ -666,6 +668,8 @@ def _start_drive(
     clipped at the controller's force or the problem's force clip."""
     force = _force_clip(compiled.problem, compiled.parts_area, s)
     if controller.kind is ControllerKind.COMPLIANT:
+        if s.compliant_in_solver:
+            return _SolverTracking(scene, controller, s, paddle, force, distance, step)
         return _Tracking(controller, s, paddle, force, distance, step)
     return _Servo(scene, controller, s, paddle, force, distance, step)
 
@@ -697,6 +701,7 @@ class _Servo:
         self.space = scene.space
         self.dt = settings.dt
         self.step = step
+        self.travel_steps = 0  # no set point: still() holds from the first step
 
     def advance(self, n: int) -> None:
         """Run ``n`` steps (the joint drives the paddle)."""
@@ -711,6 +716,20 @@ class _Servo:
     def stop(self, scene: _Scene) -> None:
         """Stop driving: the joint with no bias holds the paddle where it is."""
         lib.cpConstraintSetMaxBias(self.joint, 0.0)
+
+
+def _travel_steps(distance: float, speed: float, dt: float) -> int:
+    """The last drive step ``k`` at which a set point moving at ``speed`` is short of
+    ``distance`` (``k * speed * dt < distance``, as :meth:`_Tracking.still` judges it), 0 when
+    it starts at its end."""
+    k = max(0, math.ceil(distance / (speed * dt)) - 1)
+    if k >= 2**52:  # beyond any cap (a plan file may command 1e300 in); floats step past 1
+        return k
+    while (k + 1) * speed * dt < distance:
+        k += 1
+    while k > 0 and k * speed * dt >= distance:
+        k -= 1
+    return k
 
 
 class _Tracking:
@@ -745,6 +764,8 @@ class _Tracking:
         self.k = 0  # steps driven
         self.last_angle = paddle.pose[2]
         self.step = step
+        # Drive steps with the set point short of its end: still() is false until then.
+        self.travel_steps = _travel_steps(distance, self.speed, settings.dt)
 
     def advance(self, n: int) -> None:
         """Run ``n`` steps, setting the controller's force and torque before each."""
@@ -793,6 +814,155 @@ class _Tracking:
         lib.cpConstraintSetMaxForce(gear, self.torque)
         lib.cpSpaceAddConstraint(scene.space, gear)
         scene.constraints.extend((pivot, gear))
+
+
+#: Length (in) of the springs and dampers of :class:`_SolverTracking`, each anchored this far
+#: behind the paddle along its axis: so long that a sideways offset of tens of inches changes
+#: its length by less than 1e-4 in and turns its line by less than 1e-4 rad, so that each acts
+#: along one axis only.
+_AXIS_SPRING_LENGTH = 1.0e6
+
+
+def _lag_matched_damping(kd: float, inertia: float, dt: float) -> float:
+    """The engine's damping coefficient that gives a paddle of ``inertia`` (mass or moment)
+    tracking a set point moving at constant speed the explicit PD's lag, ``Kd v / Kp``: the
+    engine damps implicitly (velocity times ``exp(-c dt / m)`` per step), which at the same
+    ``Kd`` lags by ``1 + Kd dt / 2m`` times more; ``c = m / dt * log(1 + Kd dt / m)`` (chosen
+    on ``benchmarks/push_accuracy.py``, ``docs/design/physics.md``)."""
+    return inertia / dt * math.log1p(kd * dt / inertia)
+
+
+class _SolverTracking(_Tracking):
+    """The compliant controller of one push solved by the engine: the same PD, set point and
+    clips as :class:`_Tracking`, built from constraints so that no Python runs per step.
+
+    A kinematic *set-point body* starts at the paddle's approach pose and moves along the push
+    line at ``speed``, stopping ``distance`` along it. Per world axis, a damped spring of
+    stiffness ``Kp`` and no damping joins it to the paddle's centroid (the PD's proportional
+    term) and a damper of ``Kd`` and no stiffness joins the static body to the centroid (its
+    derivative term, on the paddle's own velocity as the PD's is); each is
+    ``_AXIS_SPRING_LENGTH`` long along its axis, so it acts along that axis alone. A rotary
+    spring of ``Kp_angle`` and ``Kd_angle`` joins the set-point body (never turning) to the
+    paddle. The engine applies the springs' forces explicitly, like the force set before a
+    step, and the dampers implicitly, their coefficients chosen so that a paddle tracking the
+    moving set point lags it as the PD's does (:func:`_lag_matched_damping`). Selected by
+    :attr:`PhysicsSettings.compliant_in_solver`.
+
+    The clips are applied between chunks of steps (:meth:`_clip`): an axis whose
+    spring force exceeds the force clip (the torque clip) has its rest length (rest angle)
+    shifted so that it pulls with the clip, until its error falls back within it.
+    """
+
+    def __init__(
+        self,
+        scene: _Scene,
+        controller: Controller,
+        settings: PhysicsSettings,
+        paddle: _Paddle,
+        default_force: float,
+        distance: float,
+        step=lib.cpSpaceStep,
+    ) -> None:
+        super().__init__(controller, settings, paddle, default_force, distance, step)
+        self.space = scene.space
+        x0, y0, th0 = paddle.pose
+        ux, uy = self.direction
+        length = _AXIS_SPRING_LENGTH
+        setpoint = lib.cpBodyNewKinematic()
+        scene.bodies.append(setpoint)
+        lib.cpBodySetPosition(setpoint, (x0, y0))  # unturned: its anchors are world axes
+        lib.cpSpaceAddBody(scene.space, setpoint)
+        self.setpoint = setpoint
+        # The engine moves the set point from step 1 to step travel_steps; advance() puts it
+        # at its end before the next.
+        if self.travel_steps > 0:
+            lib.cpBodySetVelocity(setpoint, (self.speed * ux, self.speed * uy))
+        self.interval = settings.interval_steps
+        self.end = (x0 + distance * ux, y0 + distance * uy)
+        self.springs = []
+        self.drive = []
+        for ax, ay in ((1.0, 0.0), (0.0, 1.0)):
+            spring = lib.cpDampedSpringNew(
+                setpoint, paddle.body, (-length * ax, -length * ay), (0.0, 0.0), length, self.kp, 0
+            )
+            damper = lib.cpDampedSpringNew(
+                scene.static,
+                paddle.body,
+                (x0 - length * ax, y0 - length * ay),
+                (0.0, 0.0),
+                length,
+                0.0,
+                _lag_matched_damping(self.kd, paddle.mass, settings.dt),
+            )
+            self.springs.append(spring)
+            self.drive += [spring, damper]
+        kd_angle = _lag_matched_damping(self.kd_a, paddle.moment, settings.dt)
+        self.rotary = lib.cpDampedRotarySpringNew(setpoint, paddle.body, -th0, self.kp_a, kd_angle)
+        self.drive.append(self.rotary)
+        for constraint in self.drive:
+            scene.add_constraint(constraint)
+        self.clipped = [False, False, False]
+
+    def _clip(self) -> int:
+        """Shift the rest length (angle) of each spring pulling harder than its clip so that it
+        pulls with the clip, restore those back within it, and return how many steps may pass
+        before the next call: while the set point moves, until it could bring a linear error
+        to the clip (the paddle moving back as fast), at least ``interval``; else 1 (the
+        caller's chunk)."""
+        body, clipped = self.paddle, self.clipped
+        pos = lib.cpBodyGetPosition(body)
+        target = lib.cpBodyGetPosition(self.setpoint)
+        length = _AXIS_SPRING_LENGTH
+        limit = self.force / self.kp
+        largest = 0.0
+        for axis, error in enumerate((target.x - pos.x, target.y - pos.y)):
+            largest = max(largest, abs(error))
+            if abs(error) > limit:
+                held = limit if error > 0.0 else -limit
+                lib.cpDampedSpringSetRestLength(self.springs[axis], length + held - error)
+                clipped[axis] = True
+            elif clipped[axis]:
+                lib.cpDampedSpringSetRestLength(self.springs[axis], length)
+                clipped[axis] = False
+        error = self.start[2] - lib.cpBodyGetAngle(body)
+        if abs(error) * self.kp_a > self.torque:
+            held = self.torque / self.kp_a
+            lib.cpDampedRotarySpringSetRestAngle(
+                self.rotary, error - (held if error > 0.0 else -held) - self.start[2]
+            )
+            clipped[2] = True
+        elif clipped[2]:
+            lib.cpDampedRotarySpringSetRestAngle(self.rotary, -self.start[2])
+            clipped[2] = False
+        if self.k >= self.travel_steps:
+            return 1
+        reach = self.speed * self.space_dt
+        return max(self.interval, int((limit - largest) / (2.0 * reach)))
+
+    def advance(self, n: int) -> None:
+        """Run ``n`` steps, clipping between chunks (:meth:`_clip`) and putting the set point
+        at its end before the step at which it gets there."""
+        step, space, dt = self.step, self.space, self.space_dt
+        travel = self.travel_steps
+        while n > 0:
+            chunk = min(n, self._clip())
+            k = self.k
+            if k < travel < k + chunk:
+                chunk = travel - k
+            if k == travel:
+                lib.cpBodySetVelocity(self.setpoint, (0.0, 0.0))
+                lib.cpBodySetPosition(self.setpoint, self.end)
+            for _ in range(chunk):
+                step(space, dt)
+            self.k = k + chunk
+            n -= chunk
+
+    def stop(self, scene: _Scene) -> None:
+        """Stop driving: remove the springs and dampers, then hold the paddle (the brake of
+        :meth:`_Tracking.stop`)."""
+        for constraint in self.drive:
+            lib.cpSpaceRemoveConstraint(scene.space, constraint)
+        super().stop(scene)
 
 
 class _PushRun:
@@ -872,6 +1042,15 @@ class _PushRun:
         rest = self.rest
         paddle_still = 0
         last_x, last_y = px, py
+        # The checks before the set point's end cannot find the paddle still: step over them
+        # at once (the last one only records the paddle's position).
+        skip = drive.travel_steps // interval * interval
+        if skip and self.steps + skip <= self.max_steps:
+            drive.advance(skip)
+            self.steps += skip
+            pos = lib.cpBodyGetPosition(body)
+            last_x, last_y = pos.x, pos.y
+            drive.still(ang_tol)  # records the angle, as every check does
         while True:
             self._escalate_when_stuck()
             if self.steps + interval > self.max_steps:

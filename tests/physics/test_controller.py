@@ -26,6 +26,12 @@ from arrange_up.physics.settings import DEFAULT_SETTINGS
 from arrange_up.physics.simulation import SimulationStatus, simulate, simulate_watched
 
 COMPLIANT = Controller(kind=ControllerKind.COMPLIANT)
+#: The compliant controller set from Python before every step, and solved by the engine.
+WAYS = pytest.mark.parametrize(
+    "settings",
+    [replace(DEFAULT_SETTINGS, compliant_in_solver=way) for way in (False, True)],
+    ids=["python", "solver"],
+)
 FRESH = Path(__file__).resolve().parents[1] / "problems" / "fresh"
 
 
@@ -50,7 +56,8 @@ def test_compliant_is_the_default_and_the_servo_hashes_as_problems_did_before_co
     )
 
 
-def test_compliant_free_push_ends_at_its_target_without_overshoot():
+@WAYS
+def test_compliant_free_push_ends_at_its_target_without_overshoot(settings):
     problem, _, push = scene("1 block")
     alone = tuple(o for o in problem.objects if o.kind is ObjectKind.MANIPULATOR)
     problem = replace(problem, objects=alone, controller=COMPLIANT)
@@ -60,18 +67,19 @@ def test_compliant_free_push_ends_at_its_target_without_overshoot():
         if bodies is not None:
             furthest.append(bodies[-1][0] - push.pose[0])
 
-    outcome = simulate_watched(problem, WorldState(()), push, watch, _noise())
+    outcome = simulate_watched(problem, WorldState(()), push, watch, _noise(), settings)
     assert outcome.ok
     assert outcome.manipulator_travel == pytest.approx(push.distance, abs=1e-3)
     assert max(furthest) <= push.distance + 1e-3
 
 
-def test_compliant_resisted_push_stops_short_more_under_more_friction_and_mass():
+@WAYS
+def test_compliant_resisted_push_stops_short_more_under_more_friction_and_mass(settings):
     problem, state, push = scene("1 block")
     servo = simulate(replace(problem, controller=SERVO_CONTROLLER), state, push, _noise())
     problem = replace(problem, controller=COMPLIANT)
-    light = simulate(problem, state, push, _noise(0.25, 0.1))
-    heavy = simulate(problem, state, push, _noise(0.55, 0.15))
+    light = simulate(problem, state, push, _noise(0.25, 0.1), settings)
+    heavy = simulate(problem, state, push, _noise(0.55, 0.15), settings)
     assert servo.manipulator_travel == pytest.approx(push.distance, abs=1e-3)
     short_light = push.distance - light.manipulator_travel
     short_heavy = push.distance - heavy.manipulator_travel
@@ -80,16 +88,50 @@ def test_compliant_resisted_push_stops_short_more_under_more_friction_and_mass()
     assert short_heavy == pytest.approx(0.55 * 0.15 * 386.09 / COMPLIANT.kp, rel=0.5)
 
 
-def test_compliant_paddle_turns_against_its_controller_off_centre():
+@WAYS
+def test_compliant_paddle_turns_against_its_controller_off_centre(settings):
     problem, state, push = scene("1 block")
     x, y, th = push.pose
     push = replace(push, pose=(x, y + 1.0, th))  # the block meets the paddle's end
     problem = replace(problem, controller=COMPLIANT)
     angles = []
     simulate_watched(
-        problem, state, push, lambda b: b is None or angles.append(b[-1][2]), _noise(0.55)
+        problem,
+        state,
+        push,
+        lambda b: b is None or angles.append(b[-1][2]),
+        _noise(0.55),
+        settings,
     )
     assert max(abs(a - th) for a in angles) > 1e-3
+
+
+def test_the_solver_controller_ends_pushes_where_the_python_one_does():
+    # The same PD: the chain into the wall and the lone block end within a few thousandths
+    # of an inch of each other (their steps differ, so not bit for bit).
+    python, solver = (replace(DEFAULT_SETTINGS, compliant_in_solver=w) for w in (False, True))
+    for name in ("1 block", "7-block chain"):
+        problem, state, push = scene(name)
+        a = simulate(problem, state, push, _noise(), python)
+        b = simulate(problem, state, push, _noise(), solver)
+        assert a.ok and b.ok
+        assert b.manipulator_travel == pytest.approx(a.manipulator_travel, abs=0.01)
+        for (_, p), (_, q) in zip(a.state.poses, b.state.poses, strict=True):
+            assert math.hypot(p[0] - q[0], p[1] - q[1]) < 0.02
+
+
+def test_the_solver_controller_pushes_no_harder_than_its_clip():
+    # A push commanded 5 in into the wall: the set point runs 3.5 in past the stalled paddle,
+    # whose spring alone would pull with 1,050, but the clip holds it to 100: the chain is
+    # not pushed (its friction needs about 135), as under the Python controller.
+    problem, state, push = scene("7-block chain")
+    clipped = replace(problem, controller=replace(COMPLIANT, force=100.0))
+    for way in (False, True):
+        s = replace(DEFAULT_SETTINGS, compliant_in_solver=way)
+        free = simulate(problem, state, replace(push, distance=5.0), _noise(), s)
+        held = simulate(clipped, state, replace(push, distance=5.0), _noise(), s)
+        assert free.manipulator_travel > 1.0
+        assert held.manipulator_travel < 0.5, way
 
 
 _FILE = """
