@@ -129,6 +129,7 @@ from arrange_up.repair.candidates import (
     part_swaths,
     round_pose_value,
     stage_candidates,
+    stop_placements,
 )
 from arrange_up.repair.nominal import NominalReplay
 from arrange_up.repair.records import (
@@ -140,6 +141,7 @@ from arrange_up.repair.records import (
     StepRepairStatus,
     plan_groups,
 )
+from arrange_up.repair.reliability import RemainingPlan
 from arrange_up.transitions.particles import DeterministicSemantics, ParticleSemantics
 
 __all__ = ["DEFAULT_PARTICLES", "METHODS", "Repairer", "repair_plan", "step_scores"]
@@ -244,6 +246,7 @@ def repair_plan(
                     progress,
                     len(actions),
                     guard=guard,
+                    remaining=RemainingPlan(repairer, actions, index),
                 )
                 record = StepRecord.of_push(index, action, scores)
                 after = scores.after
@@ -407,7 +410,13 @@ def step_scores(
         goal = not repairer.replay.goal_miss(states[-1])
         guard = PlanGuard(repairer.replay, deterministic, step - 1, nominal, goal)
         return repairer.one_step(
-            belief, step - 1, push, states[step - 1], states[step], guard=guard
+            belief,
+            step - 1,
+            push,
+            states[step - 1],
+            states[step],
+            guard=guard,
+            remaining=RemainingPlan(repairer, nominal, step - 1),
         )
     finally:
         repairer.close()
@@ -621,12 +630,16 @@ class Repairer:
         steps: int = 0,
         *,
         guard: PlanGuard | None = None,
+        remaining: RemainingPlan | None = None,
     ) -> StepScores:
         """ONESTEPFIXTUREPROBLEM (Figure 4-6) for ``push`` from ``belief``.
 
         With a ``guard``, only candidates it accepts are refined and may win: the best few
         placements are the best that keep the plan nominal at some multiplier, and the winner
-        the best candidate that keeps it so (see :class:`PlanGuard`)."""
+        the best candidate that keeps it so (see :class:`PlanGuard`). With ``remaining`` (the
+        nominal plan's actions after this push), the refined candidates are ranked by their
+        reliability (:mod:`arrange_up.repair.reliability`), the distance breaking ties;
+        without it, by the distance alone."""
         started = time.monotonic()
         sims_before = self.simulations
 
@@ -675,14 +688,41 @@ class Repairer:
                 not guard(replace(c, multiplier=m, push=problem.pushed(m))) for m in MULTIPLIERS
             ):
                 ranked.append(c)
-        report("refine", (len(ranked) + 1) * len(MULTIPLIERS))
-        refine_keys = [(None, None, m) for m in MULTIPLIERS] + [
-            (c.fixture, c.pose, m) for c in ranked for m in MULTIPLIERS
+        bare_keys: list[Key] = [(None, None, m) for m in MULTIPLIERS]
+        problem.evaluate(bare_keys)
+        # 5. stops where the bare push leaves a part's end uncertain
+        stops = [
+            (f, p)
+            for f, p, ok in problem.stops()
+            if ok and all((f, p) != (c.fixture, c.pose) for c in ranked)
+        ]
+        report("refine", (len(ranked) + len(stops) + 1) * len(MULTIPLIERS))
+        refine_keys = bare_keys + [
+            (f, p, m) for f, p in [(c.fixture, c.pose) for c in ranked] + stops for m in MULTIPLIERS
         ]
         problem.evaluate(refine_keys)
+        stop_set = set(stops)
         refined = normalise(
-            [candidate(key, problem.outcomes[key], problem.pushed(key[2])) for key in refine_keys]
+            [
+                replace(
+                    candidate(key, problem.outcomes[key], problem.pushed(key[2])),
+                    stop=(key[0], key[1]) in stop_set,
+                )
+                for key in refine_keys
+            ]
         )
+        # 6. reliability of every valid candidate that may win (bare pushes always: they are
+        # the bar a fixture must clear)
+        if remaining is not None:
+            refined = [
+                replace(c, reliability=remaining.reliability(outcome))
+                if c.valid
+                and (outcome := problem.outcomes[(c.fixture, c.pose, c.multiplier)].belief)
+                is not None
+                and (c.fixture is None or not c.reachable or guard is None or not guard(c))
+                else c
+                for c in refined
+            ]
         best = choose([c for c in refined if c.valid], guard)
         after = None
         if best is not None:
@@ -762,6 +802,25 @@ class _OneStepProblem:
             )
             self.outcomes[key] = Outcome(bare, r.distance(bare, self.nominal_next))
         return swaths
+
+    def stops(self) -> list[tuple[str, Pose, bool]]:
+        """The stop placements of the bare push at 1x (:func:`stop_placements`); none
+        without fixtures or when that push fails."""
+        r, belief = self.repairer, self.belief
+        outcome = self.outcomes.get((None, None, 1.0))
+        if not r.fixtures or outcome is None or outcome.belief is None:
+            return []
+        return stop_placements(
+            r.problem,
+            r.checker,
+            r.intervals(belief),
+            belief.names(),
+            self.pushed(1.0),
+            belief,
+            outcome.belief,
+            self.nominal_next,
+            r.parts,
+        )
 
     def grid(self, swaths: tuple[Swath, ...]) -> list[tuple[str, Pose, bool]]:
         """The placement grid (``(fixture, pose, allowed)``); for the enhanced method only the
