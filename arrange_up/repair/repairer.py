@@ -2,8 +2,9 @@
 
 :func:`repair_plan` turns every push of a nominal plan (:mod:`arrange_up.repair.nominal`)
 into ``place(fixture), push, pick(fixture)``, choosing where the fixture goes and how far the
-push drives so that the particle belief stays as close as possible to the nominal trajectory
-("control along the trajectory", §4.1.1)::
+push drives so that the rest of the nominal plan reaches the goal from as much of the particle
+belief as possible, the closeness to the nominal trajectory ("control along the trajectory",
+§4.1.1) breaking ties::
 
     from arrange_up.io.domains import load
     from arrange_up.repair import nominal_plans, repair_plan
@@ -49,14 +50,21 @@ failure, never a silently unreliable plan.
    (0 is best). When no candidate is valid at 2x, the selection falls back to the next smaller
    multiplier.
 4. *Push distance* (OPTIMIZEPUSHDISTANCE): the best :data:`REFINE` placements (of those that
-   keep the plan nominal at some multiplier, item 6) and "no fixture"
-   are simulated at every multiplier of :data:`MULTIPLIERS` (1, 1.25, 1.5, 1.75, 2; the push
-   keeps its approach pose, only its distance grows) and the pair with the smallest distance
-   wins (ties: the smaller multiplier). A fixture must beat the best bare push by more than
-   :data:`MIN_FIXTURE_GAIN` (1%, at least 0.01 in): a fixture the parts never touch changes
-   the simulation only by round-off, and placing it would add two actions and a place's risk
-   for nothing. The thesis optimised the multiplier for the one best placement; keeping a few
-   guards against a placement that is best at 2x only.
+   keep the plan nominal at some multiplier, item 6), the *stops* (fixtures flush with a moved
+   part's nominal end along the axis its end is uncertain, on the placement grid:
+   :func:`~arrange_up.repair.candidates.stop_placements`) and "no fixture" are simulated at
+   every multiplier of :data:`MULTIPLIERS` (1, 1.25, 1.5, 1.75, 2; the push keeps its
+   approach pose, only its distance grows). Each valid pair that may win is scored by its
+   *reliability*: the share of rollouts of the nominal plan's remaining actions from its
+   outcome that reach the goal, with common random numbers across the pairs
+   (:mod:`arrange_up.repair.reliability`). The most reliable wins, the distance breaking ties
+   (then the smaller multiplier). A fixture must be more reliable than the best bare push, or
+   as reliable and closer by more than :data:`MIN_FIXTURE_GAIN` (1%, at least 0.01 in): a
+   fixture the parts never touch changes the simulation only by round-off, and placing it
+   would add two actions and a place's risk for nothing. The thesis optimised the multiplier
+   for the one best placement by distance; the distance does not track what a fixture is for
+   (a stop that makes a part's end certain can leave it farther from the nominal state on
+   average), hence the reliability.
 5. The push becomes ``place(fixture, pose), push(distance * multiplier), pick(fixture)``, or
    ``push(distance * multiplier)`` without a fixture.
 6. *The plan stays a nominal plan* (:class:`PlanGuard`). A candidate may be refined or win
