@@ -5,6 +5,8 @@ One module per concern:
 * :mod:`~arrange_up.repair.nominal`: distinct nominal plans (:func:`nominal_plans`);
 * :mod:`~arrange_up.repair.candidates`: the candidates of a one-step fixture problem, their
   scores and the winner (:class:`Candidate`, :class:`StepScores`, the tuning constants);
+* :mod:`~arrange_up.repair.reliability`: how reliably the rest of the plan reaches the goal
+  from a candidate's outcome, the score candidates are ranked by (:class:`RemainingPlan`);
 * :mod:`~arrange_up.repair.repairer`: the repair itself (:func:`repair_plan`,
   :func:`step_scores`);
 * :mod:`~arrange_up.repair.records`: what a repair reports and the plan file it writes
@@ -42,6 +44,7 @@ from arrange_up.repair.records import (
     StepRepairStatus,
     plan_groups,
 )
+from arrange_up.repair.reliability import MIN_ROLLOUTS, RemainingPlan
 from arrange_up.repair.repairer import (
     DEFAULT_PARTICLES,
     METHODS,
@@ -60,6 +63,7 @@ __all__ = [
     "INVALID",
     "MAX_BACKOFF",
     "METHODS",
+    "MIN_ROLLOUTS",
     "MIN_FIXTURE_GAIN",
     "MULTIPLIERS",
     "OK",
@@ -71,6 +75,7 @@ __all__ = [
     "Candidate",
     "CandidateStatus",
     "ProgressCallback",
+    "RemainingPlan",
     "RepairResult",
     "RepairStats",
     "RepairStatus",

@@ -78,8 +78,13 @@ class Candidate:
     ``"invalid"`` (some particle's push failed; ``reason`` says how). ``distance`` is the mean
     Manhattan distance to the nominal next state (``inf`` when invalid, ``nan`` when blocked);
     ``score`` its min-max normalised value among the valid candidates of the same stage (0 is
-    best; ``None`` unless ``ok``). ``push`` is the push it simulates: the nominal push's
-    (backed-off, see :class:`StepScores`) approach pose, its distance times ``multiplier``.
+    best; ``None`` unless ``ok``). ``reliability`` is the share of rollouts of the nominal
+    plan's remaining actions from its outcome that reach the goal
+    (:mod:`arrange_up.repair.reliability`; ``None`` when not estimated: candidates of the
+    placement stage, invalid ones and those the plan check refused). ``push`` is the push it
+    simulates: the nominal push's (backed-off, see :class:`StepScores`) approach pose, its
+    distance times ``multiplier``. ``stop`` marks a placement made to stop a part where its
+    end is uncertain (:func:`stop_placements`).
     """
 
     fixture: str | None
@@ -91,6 +96,8 @@ class Candidate:
     reachable: bool = True
     reason: str = ""
     push: Push | None = None
+    reliability: float | None = None
+    stop: bool = False
 
     @property
     def valid(self) -> bool:
@@ -114,6 +121,10 @@ class Candidate:
             "distance": json_float(self.distance),
             "score": None if self.score is None else json_round(self.score),
         }
+        if self.reliability is not None:
+            data["reliability"] = json_round(self.reliability)
+        if self.stop:
+            data["stop"] = True
         if not self.reachable:
             data["reachable"] = False
         if self.reason:
@@ -213,9 +224,7 @@ def grid_placements(
     table, clear of every shadow) with the push's approach shadow counted as an obstacle.
     """
     width, depth = problem.table.size
-    place_unc = problem.uncertainty.place
-    others = [(name, iv.center, iv.half) for name, iv in intervals.objects]
-    others.append((push.manipulator, push.pose, problem.uncertainty.push))
+    allowed = _place_check(problem, checker, intervals, push)
     xs = _grid(width, GRID_STEP)
     ys = _grid(depth, GRID_STEP)
     out = []
@@ -226,11 +235,105 @@ def grid_placements(
             for y in ys:
                 for x in xs:
                     pose = (x, y, theta)
-                    allowed = checker.shadow_inside_table(
-                        spec.name, pose, place_unc
-                    ) and checker.shadow_clear(spec.name, pose, place_unc, others)
-                    out.append((spec.name, pose, allowed))
+                    out.append((spec.name, pose, allowed(spec.name, pose)))
     return out
+
+
+def stop_placements(
+    problem: ArrangementProblem,
+    checker: CollisionChecker,
+    intervals: IntervalBelief,
+    on_table: Sequence[str],
+    push: Push,
+    before: ParticleBelief,
+    ends: ParticleBelief,
+    nominal_next: WorldState,
+    parts: Sequence[str],
+) -> list[tuple[str, Pose, bool]]:
+    """Grid placements where a fixture stops a pushed part along the direction its end is
+    uncertain: ``(fixture, pose, allowed)`` as :func:`grid_placements` gives them.
+
+    ``ends`` is the belief ``before`` after the bare push (the same particles, in order). For
+    every part of ``parts`` that the push moved,
+    the axis (x or y) along which its end positions spread most, and the other axis too when
+    its spread is at least half as wide, is *uncertain*. On each side of the part's footprint
+    in ``nominal_next`` along such an axis, each fixture off the table is turned its thin way
+    towards the part and placed flush with that footprint, its centre moved to the two nearest
+    points of the placement grid (:data:`GRID_STEP`) along the axis and across it. The side
+    behind the part along the push is left out: a fixture there stands in the part's way.
+    """
+    spec_push = problem.object(push.manipulator)
+    ux, uy = rotate(spec_push.push_direction, push.pose[2])
+    along_push = (round(ux), round(uy))
+    nominal = nominal_next.as_dict()
+    names = ends.names()
+    allowed = _place_check(problem, checker, intervals, push)
+    width, depth = problem.table.size
+    lines = (_grid(width, GRID_STEP), _grid(depth, GRID_STEP))
+    out: dict[tuple[str, Pose], bool] = {}
+    for k, name in enumerate(names):
+        if name not in parts or name not in nominal:
+            continue
+        if name not in before.names() or np.allclose(
+            before.poses[:, before.names().index(name), :2], ends.poses[:, k, :2], atol=1e-6
+        ):
+            continue
+        spread = ends.poses[:, k, :2].std(axis=0)
+        if not spread.max() > 0.0:
+            continue
+        box = checker.shadow_box(name, nominal[name], _ZERO)
+        centre = ((box[0] + box[2]) / 2, (box[1] + box[3]) / 2)
+        for axis in (0, 1):
+            if spread[axis] < 0.5 * spread.max():
+                continue
+            across = 1 - axis
+            for side in (-1, 1):
+                if along_push[axis] == -side:  # behind the part: in its way
+                    continue
+                for spec in problem.fixtures:
+                    if spec.name in on_table:
+                        continue
+                    theta, half = min(
+                        (
+                            (t, (b[2 + axis] - b[axis]) / 2)
+                            for t in fixture_angles(problem, spec.name)
+                            for b in (footprint(checker, spec.name, (0.0, 0.0, t)),)
+                        ),
+                        key=lambda th: th[1],
+                    )
+                    face = box[2 + axis] if side > 0 else box[axis]
+                    flush = face + side * half
+                    for a in _nearest(lines[axis], flush):
+                        for c in _nearest(lines[across], centre[across]):
+                            xy = (a, c) if axis == 0 else (c, a)
+                            pose = (xy[0], xy[1], theta)
+                            if (spec.name, pose) not in out:
+                                out[(spec.name, pose)] = allowed(spec.name, pose)
+    return [(fixture, pose, ok) for (fixture, pose), ok in out.items()]
+
+
+def _place_check(
+    problem: ArrangementProblem, checker: CollisionChecker, intervals: IntervalBelief, push: Push
+) -> Callable[[str, Pose], bool]:
+    """The place precondition on the belief ``intervals``: the fixture's place shadow on the
+    table, clear of every shadow and of the push's approach shadow."""
+    place_unc = problem.uncertainty.place
+    others = [(name, iv.center, iv.half) for name, iv in intervals.objects]
+    others.append((push.manipulator, push.pose, problem.uncertainty.push))
+
+    def allowed(fixture: str, pose: Pose) -> bool:
+        return checker.shadow_inside_table(fixture, pose, place_unc) and checker.shadow_clear(
+            fixture, pose, place_unc, others
+        )
+
+    return allowed
+
+
+def _nearest(lines: Sequence[float], value: float) -> list[float]:
+    """The two grid lines nearest ``value`` (one when it lies on a line or past the ends)."""
+    below = [v for v in lines if v <= value + 1e-9]
+    above = [v for v in lines if v >= value - 1e-9]
+    return sorted({*below[-1:], *above[:1]})
 
 
 def part_swaths(
@@ -331,9 +434,10 @@ def stage_candidates(
 def choose(
     valid: list[Candidate], rejects: Callable[[Candidate], str] | None = None
 ) -> Candidate | None:
-    """The winner among valid candidates: the smallest distance (ties: the smaller
-    multiplier), except that a fixture must beat the best bare push by
-    :data:`MIN_FIXTURE_GAIN`.
+    """The winner among valid candidates: the most reliable (:attr:`Candidate.reliability`,
+    0 when not estimated), ties broken by the smaller distance, then the smaller multiplier;
+    except that a fixture must beat the best bare push: be more reliable, or as reliable and
+    closer by more than :data:`MIN_FIXTURE_GAIN`.
 
     ``rejects`` (when given) says why a candidate may not win (empty when it may): the repair
     rejects a candidate whose plan is no longer a nominal plan. It is asked lazily, best
@@ -345,7 +449,7 @@ def choose(
         return None
 
     def best(group: list[Candidate]) -> Candidate | None:
-        for c in sorted(group, key=lambda c: (c.distance, c.multiplier)):
+        for c in sorted(group, key=rank):
             if rejects is None or not rejects(c):
                 return c
         return None
@@ -358,13 +462,25 @@ def choose(
     # the bar a fixture must clear is the best bare push; when ``rejects`` refuses every bare
     # push, still the best of them: a fixture that scores worse than pushing without it is
     # never placed (no candidate wins then)
-    reference = best_bare or min(bare, key=lambda c: (c.distance, c.multiplier), default=None)
+    reference = best_bare or min(bare, key=rank, default=None)
     if reference is None:
         return best_fixed
+    gained = _reliability(best_fixed) - _reliability(reference)
+    if gained > 0:
+        return best_fixed
     gain = reference.distance - best_fixed.distance
-    if gain > max(MIN_FIXTURE_GAIN[0], MIN_FIXTURE_GAIN[1] * reference.distance):
+    if gained == 0 and gain > max(MIN_FIXTURE_GAIN[0], MIN_FIXTURE_GAIN[1] * reference.distance):
         return best_fixed
     return best_bare
+
+
+def rank(c: Candidate) -> tuple[float, float, float]:
+    """The order :func:`choose` prefers candidates in: most reliable, closest, shortest."""
+    return (-_reliability(c), c.distance, c.multiplier)
+
+
+def _reliability(c: Candidate) -> float:
+    return 0.0 if c.reliability is None else c.reliability
 
 
 def normalise(candidates: list[Candidate]) -> list[Candidate]:

@@ -58,9 +58,12 @@ class StepRecord:
     ``kind`` is the nominal action's type; ``actions`` what replaced it (the action itself for a
     place or pick). For a push: the chosen ``fixture``, ``pose`` and ``multiplier``, the chosen
     candidate's ``distance`` and the bare nominal push's (``nominal_distance``, multiplier 1,
-    ``inf`` if invalid), the approach ``backoff`` (see :class:`StepScores`) and candidate
-    counts (``rejected``: valid candidates refused because the plan would no longer be a
-    nominal plan with them). ``status`` is ``"ok"`` or ``"failed"``.
+    ``inf`` if invalid), the chosen candidate's ``reliability`` and the bare nominal push's
+    (``nominal_reliability``; ``None`` when not estimated), the approach ``backoff`` (see
+    :class:`StepScores`) and candidate counts (``rejected``: valid candidates refused because
+    the plan would no longer be a nominal plan with them; ``stops``: placements made to stop a
+    part where its end is uncertain, blocked ones left out). ``status`` is ``"ok"`` or
+    ``"failed"``.
     """
 
     index: int
@@ -75,7 +78,10 @@ class StepRecord:
     distance: float | None = None
     nominal_distance: float | None = None
     score: float | None = None
+    reliability: float | None = None
+    nominal_reliability: float | None = None
     placements: int = 0
+    stops: int = 0
     blocked: int = 0
     invalid: int = 0
     unreachable: int = 0
@@ -100,6 +106,8 @@ class StepRecord:
             "selection_multiplier": scores.selection_multiplier,
             "backoff": scores.backoff,
             "nominal_distance": bare.distance,
+            "nominal_reliability": bare.reliability,
+            "stops": len({(c.fixture, c.pose) for c in scores.refined if c.stop}),
             "simulations": scores.simulations,
             "elapsed": scores.elapsed,
         }
@@ -140,6 +148,7 @@ class StepRecord:
             multiplier=best.multiplier,
             distance=best.distance,
             score=best.score,
+            reliability=best.reliability,
             **common,
         )
 
@@ -152,6 +161,16 @@ class StepRecord:
         # next state, the bare nominal push's beside it (None when that push was invalid)
         bare = "invalid" if self.nominal_distance is None else f"{self.nominal_distance:.3f}"
         distance = f"mean distance to the nominal state {self.distance:.3f} (bare push {bare})"
+        if self.reliability is not None:
+            nominal = (
+                "invalid"
+                if self.nominal_reliability is None
+                else f"{100 * self.nominal_reliability:.0f} %"
+            )
+            distance = (
+                f"the rest of the plan reaches the goal from {100 * self.reliability:.0f} % "
+                f"(bare push {nominal}), {distance}"
+            )
         if self.fixture is None or self.pose is None:
             return f"no fixture, x{self.multiplier:g}, {distance}"
         x, y, theta = units.pose_out(self.pose)
@@ -178,9 +197,12 @@ class StepRecord:
                 multiplier=self.multiplier,
                 distance=json_float(self.distance),
                 nominal_distance=json_float(self.nominal_distance),
+                reliability=json_float(self.reliability),
+                nominal_reliability=json_float(self.nominal_reliability),
                 selection_multiplier=self.selection_multiplier,
                 backoff=json_round(self.backoff),
                 placements=self.placements,
+                stops=self.stops,
                 blocked=self.blocked,
                 invalid=self.invalid,
                 unreachable=self.unreachable,

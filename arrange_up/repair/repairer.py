@@ -2,8 +2,9 @@
 
 :func:`repair_plan` turns every push of a nominal plan (:mod:`arrange_up.repair.nominal`)
 into ``place(fixture), push, pick(fixture)``, choosing where the fixture goes and how far the
-push drives so that the particle belief stays as close as possible to the nominal trajectory
-("control along the trajectory", §4.1.1)::
+push drives so that the rest of the nominal plan reaches the goal from as much of the particle
+belief as possible, the closeness to the nominal trajectory ("control along the trajectory",
+§4.1.1) breaking ties::
 
     from arrange_up.io.domains import load
     from arrange_up.repair import nominal_plans, repair_plan
@@ -49,14 +50,21 @@ failure, never a silently unreliable plan.
    (0 is best). When no candidate is valid at 2x, the selection falls back to the next smaller
    multiplier.
 4. *Push distance* (OPTIMIZEPUSHDISTANCE): the best :data:`REFINE` placements (of those that
-   keep the plan nominal at some multiplier, item 6) and "no fixture"
-   are simulated at every multiplier of :data:`MULTIPLIERS` (1, 1.25, 1.5, 1.75, 2; the push
-   keeps its approach pose, only its distance grows) and the pair with the smallest distance
-   wins (ties: the smaller multiplier). A fixture must beat the best bare push by more than
-   :data:`MIN_FIXTURE_GAIN` (1%, at least 0.01 in): a fixture the parts never touch changes
-   the simulation only by round-off, and placing it would add two actions and a place's risk
-   for nothing. The thesis optimised the multiplier for the one best placement; keeping a few
-   guards against a placement that is best at 2x only.
+   keep the plan nominal at some multiplier, item 6), the *stops* (fixtures flush with a moved
+   part's nominal end along the axis its end is uncertain, on the placement grid:
+   :func:`~arrange_up.repair.candidates.stop_placements`) and "no fixture" are simulated at
+   every multiplier of :data:`MULTIPLIERS` (1, 1.25, 1.5, 1.75, 2; the push keeps its
+   approach pose, only its distance grows). Each valid pair that may win is scored by its
+   *reliability*: the share of rollouts of the nominal plan's remaining actions from its
+   outcome that reach the goal, with common random numbers across the pairs
+   (:mod:`arrange_up.repair.reliability`). The most reliable wins, the distance breaking ties
+   (then the smaller multiplier). A fixture must be more reliable than the best bare push, or
+   as reliable and closer by more than :data:`MIN_FIXTURE_GAIN` (1%, at least 0.01 in): a
+   fixture the parts never touch changes the simulation only by round-off, and placing it
+   would add two actions and a place's risk for nothing. The thesis optimised the multiplier
+   for the one best placement by distance; the distance does not track what a fixture is for
+   (a stop that makes a part's end certain can leave it farther from the nominal state on
+   average), hence the reliability.
 5. The push becomes ``place(fixture, pose), push(distance * multiplier), pick(fixture)``, or
    ``push(distance * multiplier)`` without a fixture.
 6. *The plan stays a nominal plan* (:class:`PlanGuard`). A candidate may be refined or win
@@ -129,6 +137,7 @@ from arrange_up.repair.candidates import (
     part_swaths,
     round_pose_value,
     stage_candidates,
+    stop_placements,
 )
 from arrange_up.repair.nominal import NominalReplay
 from arrange_up.repair.records import (
@@ -140,6 +149,7 @@ from arrange_up.repair.records import (
     StepRepairStatus,
     plan_groups,
 )
+from arrange_up.repair.reliability import RemainingPlan
 from arrange_up.transitions.particles import DeterministicSemantics, ParticleSemantics
 
 __all__ = ["DEFAULT_PARTICLES", "METHODS", "Repairer", "repair_plan", "step_scores"]
@@ -244,6 +254,7 @@ def repair_plan(
                     progress,
                     len(actions),
                     guard=guard,
+                    remaining=RemainingPlan(repairer, actions, index),
                 )
                 record = StepRecord.of_push(index, action, scores)
                 after = scores.after
@@ -407,7 +418,13 @@ def step_scores(
         goal = not repairer.replay.goal_miss(states[-1])
         guard = PlanGuard(repairer.replay, deterministic, step - 1, nominal, goal)
         return repairer.one_step(
-            belief, step - 1, push, states[step - 1], states[step], guard=guard
+            belief,
+            step - 1,
+            push,
+            states[step - 1],
+            states[step],
+            guard=guard,
+            remaining=RemainingPlan(repairer, nominal, step - 1),
         )
     finally:
         repairer.close()
@@ -621,12 +638,16 @@ class Repairer:
         steps: int = 0,
         *,
         guard: PlanGuard | None = None,
+        remaining: RemainingPlan | None = None,
     ) -> StepScores:
         """ONESTEPFIXTUREPROBLEM (Figure 4-6) for ``push`` from ``belief``.
 
         With a ``guard``, only candidates it accepts are refined and may win: the best few
         placements are the best that keep the plan nominal at some multiplier, and the winner
-        the best candidate that keeps it so (see :class:`PlanGuard`)."""
+        the best candidate that keeps it so (see :class:`PlanGuard`). With ``remaining`` (the
+        nominal plan's actions after this push), the refined candidates are ranked by their
+        reliability (:mod:`arrange_up.repair.reliability`), the distance breaking ties;
+        without it, by the distance alone."""
         started = time.monotonic()
         sims_before = self.simulations
 
@@ -675,14 +696,41 @@ class Repairer:
                 not guard(replace(c, multiplier=m, push=problem.pushed(m))) for m in MULTIPLIERS
             ):
                 ranked.append(c)
-        report("refine", (len(ranked) + 1) * len(MULTIPLIERS))
-        refine_keys = [(None, None, m) for m in MULTIPLIERS] + [
-            (c.fixture, c.pose, m) for c in ranked for m in MULTIPLIERS
+        bare_keys: list[Key] = [(None, None, m) for m in MULTIPLIERS]
+        problem.evaluate(bare_keys)
+        # 5. stops where the bare push leaves a part's end uncertain
+        stops = [
+            (f, p)
+            for f, p, ok in problem.stops()
+            if ok and all((f, p) != (c.fixture, c.pose) for c in ranked)
+        ]
+        report("refine", (len(ranked) + len(stops) + 1) * len(MULTIPLIERS))
+        refine_keys = bare_keys + [
+            (f, p, m) for f, p in [(c.fixture, c.pose) for c in ranked] + stops for m in MULTIPLIERS
         ]
         problem.evaluate(refine_keys)
+        stop_set = set(stops)
         refined = normalise(
-            [candidate(key, problem.outcomes[key], problem.pushed(key[2])) for key in refine_keys]
+            [
+                replace(
+                    candidate(key, problem.outcomes[key], problem.pushed(key[2])),
+                    stop=(key[0], key[1]) in stop_set,
+                )
+                for key in refine_keys
+            ]
         )
+        # 6. reliability of every valid candidate that may win (bare pushes always: they are
+        # the bar a fixture must clear)
+        if remaining is not None:
+            refined = [
+                replace(c, reliability=remaining.reliability(outcome))
+                if c.valid
+                and (outcome := problem.outcomes[(c.fixture, c.pose, c.multiplier)].belief)
+                is not None
+                and (c.fixture is None or not c.reachable or guard is None or not guard(c))
+                else c
+                for c in refined
+            ]
         best = choose([c for c in refined if c.valid], guard)
         after = None
         if best is not None:
@@ -762,6 +810,25 @@ class _OneStepProblem:
             )
             self.outcomes[key] = Outcome(bare, r.distance(bare, self.nominal_next))
         return swaths
+
+    def stops(self) -> list[tuple[str, Pose, bool]]:
+        """The stop placements of the bare push at 1x (:func:`stop_placements`); none
+        without fixtures or when that push fails."""
+        r, belief = self.repairer, self.belief
+        outcome = self.outcomes.get((None, None, 1.0))
+        if not r.fixtures or outcome is None or outcome.belief is None:
+            return []
+        return stop_placements(
+            r.problem,
+            r.checker,
+            r.intervals(belief),
+            belief.names(),
+            self.pushed(1.0),
+            belief,
+            outcome.belief,
+            self.nominal_next,
+            r.parts,
+        )
 
     def grid(self, swaths: tuple[Swath, ...]) -> list[tuple[str, Pose, bool]]:
         """The placement grid (``(fixture, pose, allowed)``); for the enhanced method only the

@@ -44,8 +44,11 @@ SCALED_DOWN: dict[str, str] = {
     "arrange-up show blocks-7 --plan b7.json --rollouts 100 -o story.png": (
         "arrange-up show blocks-7 --plan b7.json --rollouts 5 -o story.png"
     ),
-    "arrange-up repair tz-mating --particles 150 -o tz.fixtures.json": (
-        "arrange-up repair tz-mating --particles 10 -o tz.fixtures.json"
+    "arrange-up evaluate tz-mating tz.fixtures.json --rollouts 300": (
+        "arrange-up evaluate tz-mating tz.fixtures.json --rollouts 20"
+    ),
+    "arrange-up evaluate tz-mating tz.bare.json --rollouts 300": (
+        "arrange-up evaluate tz-mating tz.bare.json --rollouts 20"
     ),
     "arrange-up experiment transition-comparison --runs 3 --rollouts 300": (
         "arrange-up experiment transition-comparison --problems blocks-4 --particles 5"

@@ -554,3 +554,121 @@ def test_a_choice_line_calls_its_score_a_mean_distance_not_a_push_length():
     assert line == "no fixture, x1, mean distance to the nominal state 0.198 (bare push invalid)"
     bare = StepRecord(0, "push", push, (push,), multiplier=1.0, distance=0.2, nominal_distance=0.3)
     assert bare.describe_choice(load("blocks-1")).endswith("state 0.200 (bare push 0.300)")
+
+
+def test_the_choice_ranks_by_reliability_with_the_distance_as_tie_break():
+    push = Push("paddle", (0.0, 0.0, 0.0), 1.0)
+
+    def cand(fixture, distance, reliability, multiplier=1.0):
+        pose = None if fixture is None else (1.0, 1.0, 0.0)
+        return rp.Candidate(
+            fixture, pose, multiplier, "ok", distance, push=push, reliability=reliability
+        )
+
+    close_bare = cand(None, 0.1, 0.5)
+    reliable_bare = cand(None, 0.3, 0.6, 1.5)
+    assert candidates.choose([close_bare, reliable_bare]) is reliable_bare
+    # a fixture farther from the nominal state wins when more reliable
+    stop = cand("bar", 0.4, 0.7)
+    assert candidates.choose([close_bare, reliable_bare, stop]) is stop
+    # as reliable as the best bare push: it needs the distance gain of MIN_FIXTURE_GAIN
+    assert candidates.choose([reliable_bare, cand("bar", 0.299, 0.6)]) is reliable_bare
+    tied = cand("bar", 0.2, 0.6)
+    assert candidates.choose([reliable_bare, tied]) is tied
+    # less reliable: never, however close
+    assert candidates.choose([reliable_bare, cand("bar", 0.0, 0.55)]) is reliable_bare
+
+
+def test_rollouts_per_particle_reach_the_minimum_only_when_noise_remains():
+    from arrange_up.repair.reliability import MIN_ROLLOUTS, rollouts_per_particle
+
+    push = Push("paddle", (0.0, 0.0, 0.0), 1.0)
+    assert rollouts_per_particle(10, (push,)) * 10 >= MIN_ROLLOUTS
+    assert rollouts_per_particle(10 * MIN_ROLLOUTS, (push,)) == 1
+    assert rollouts_per_particle(10, ()) == 1
+    assert rollouts_per_particle(10, (Pick("bar"),)) == 1
+
+
+def test_reliability_is_the_share_of_rollouts_of_the_rest_that_reach_the_goal(tz):
+    from arrange_up.repair.reliability import RemainingPlan
+
+    nominal = rp.nominal_plans(tz, 1, seed=0)[0]
+    repairer = Repairer(tz, 8, 0, "enhanced", 1, None)
+    try:
+        states = repairer.nominal_states(nominal)
+        nominal_end = repairer.replay.initial()
+        for action in nominal:
+            nominal_end, _ = repairer.replay.apply(nominal_end, (action,))
+        # nothing left to do: the share of particles in the goal
+        done = RemainingPlan(repairer, nominal, len(nominal) - 1)
+        assert done.reliability(nominal_end) == 1.0
+        start = RemainingPlan(repairer, nominal, -1)  # the whole plan from the initial belief
+        assert done.reliability(repairer.replay.initial()) == 0.0
+        belief = repairer.initial_belief()
+        share = start.reliability(belief)
+        assert 0.0 <= share <= 1.0
+        # common random numbers: the same belief, another object, scores the same
+        again = RemainingPlan(repairer, nominal, -1)
+        assert again.reliability(belief) == share
+        # from the nominal state itself, with noise, the plan reaches the goal at least
+        # sometimes (the plan is a nominal plan)
+        assert (
+            RemainingPlan(repairer, nominal, -1).reliability(repairer.replay.initial()) > 0.0
+            or not states
+        )
+    finally:
+        repairer.close()
+
+
+def test_stop_placements_lie_on_the_grid_flush_with_the_nominal_end(tz):
+    nominal = rp.nominal_plans(tz, 1, seed=0)[0]
+    repairer = Repairer(tz, 10, 0, "enhanced", 1, None)
+    try:
+        states = repairer.nominal_states(nominal)
+        belief = repairer.initial_belief()
+        push = nominal[0]
+        [ends] = repairer.pushes([(belief, push)], 0)
+        assert ends.belief is not None
+        stops = candidates.stop_placements(
+            tz,
+            repairer.checker,
+            repairer.intervals(belief),
+            belief.names(),
+            push,
+            belief,
+            ends.belief,
+            states[1],
+            repairer.parts,
+        )
+    finally:
+        repairer.close()
+    assert stops
+    moved = [
+        name for name, pose in states[1].poses if pose != dict(states[0].poses).get(name, pose)
+    ]
+    for fixture, pose, _allowed in stops:
+        assert fixture == "bar"
+        for v in pose[:2]:
+            assert v / candidates.GRID_STEP == pytest.approx(round(v / candidates.GRID_STEP))
+        bar = candidates.footprint(repairer.checker, fixture, pose)
+        # within one grid step of a moved part's nominal end footprint, on some side
+        near = False
+        for name in moved:
+            box = repairer.checker.shadow_box(name, dict(states[1].poses)[name], (0.0, 0.0, 0.0))
+            gaps = (box[0] - bar[2], bar[0] - box[2], box[1] - bar[3], bar[1] - box[3])
+            near = near or any(-candidates.GRID_STEP <= g <= candidates.GRID_STEP for g in gaps)
+        assert near, pose
+
+
+def test_a_tz_repair_places_a_fixture_more_reliable_than_the_bare_push(tz):
+    nominal = rp.nominal_plans(tz, 1, seed=0)[0]
+    result = rp.repair_plan(tz, nominal, particles=10, seed=0)
+    assert result.solved
+    placed = [s for s in result.steps if s.fixture is not None]
+    assert placed
+    for step in placed:
+        assert step.reliability is not None and step.nominal_reliability is not None
+        assert step.reliability > step.nominal_reliability
+    document = result.document(tz)
+    record = document["repair"]["steps"][0]
+    assert "reliability" in record and "nominal_reliability" in record and "stops" in record
