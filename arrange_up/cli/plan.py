@@ -27,6 +27,7 @@ from arrange_up.cli.shared import (
     seed_option,
     terminal_progress,
     timeout_option,
+    writing_output,
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
@@ -246,7 +247,8 @@ def plan(
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
     document = result.document(loaded, model)
     if output:
-        write_json_atomic(Path(output), document)
+        with writing_output(output):
+            write_json_atomic(Path(output), document)
     if as_json:
         plan_length = len(result.actions) if result.actions is not None else None
         echo_json(document_summary(document, output, plan_length=plan_length, reason=result.reason))

@@ -20,6 +20,7 @@ from arrange_up.cli.shared import (
     load_problem,
     read_plan_file,
     seed_option,
+    writing_output,
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
@@ -171,7 +172,8 @@ def repair(
         fail(str(error))
     document = result.document(loaded)
     if output:
-        write_json_atomic(Path(output), document)
+        with writing_output(output):
+            write_json_atomic(Path(output), document)
     if as_json:
         echo_json(document_summary(document, output, reason=result.reason or None))
     else:

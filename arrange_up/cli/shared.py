@@ -47,6 +47,16 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
     sys.exit(code)
 
 
+@contextmanager
+def writing_output(output: str | os.PathLike[str]) -> Iterator[None]:
+    """Around writing the file ``-o output``: an ``OSError`` (a full disk, ``/dev/full``, a
+    directory) ends the command with one line naming the file, exit status 2."""
+    try:
+        yield
+    except OSError as error:
+        fail(f"{os.fsdecode(output)}: cannot write: {error.strerror or error}")
+
+
 #: A seed: a non-negative integer (numpy's seed sequences refuse negative ones).
 SEED = click.IntRange(0, None)
 

@@ -148,3 +148,28 @@ def test_plan_and_evaluate_show_their_progress_on_a_terminal(monkeypatch, capsys
     assert "blocks-1: solved" in printed and "of 2 rollouts reached the goal" in printed
     drawn = terminal.getvalue()
     assert "expanded" in drawn and "rollouts" in drawn and "ok (" in drawn
+
+
+def test_a_failed_output_write_is_one_line_exit_2(tmp_path, monkeypatch):
+    # a full disk or /dev/full (not written here: code that replaced the device node would
+    # destroy it on a machine running the tests as root)
+    import errno
+
+    import arrange_up.cli.problems as problems
+
+    def full(path, text):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(problems, "write_text_atomic", full)
+    result = CliRunner().invoke(main, ["export", "blocks-1", "-o", str(tmp_path / "b.pddl")])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (
+        f"arrange-up: {tmp_path / 'b.pddl'}: cannot write: No space left on device"
+    )
+
+
+def test_output_onto_a_symlink_writes_its_target_and_keeps_the_link(tmp_path):
+    link = tmp_path / "link.pddl"
+    link.symlink_to(tmp_path / "target.pddl")
+    assert CliRunner().invoke(main, ["export", "blocks-1", "-o", str(link)]).exit_code == 0
+    assert link.is_symlink() and (tmp_path / "target.pddl").read_text().startswith(";")
