@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import sys
 
 import click
@@ -62,10 +63,36 @@ def test_load_problem_refuses_cleanly(tmp_path, capsys):
     assert "nothing was done" in capsys.readouterr().err
 
 
-def test_no_progress_display_off_a_terminal(monkeypatch):
-    monkeypatch.setattr(sys, "stderr", io.StringIO())
-    with shared.terminal_progress(TextColumn("x")) as display:
+def test_off_a_terminal_progress_is_a_line_every_interval_and_quiet_silences_it(monkeypatch):
+    import time
+
+    stream = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", stream)
+    monkeypatch.setattr(shared, "PROGRESS_INTERVAL", 0.05)
+    with shared.terminal_progress(TextColumn("x"), what="evaluate") as display:
+        assert isinstance(display, shared.LineProgress)
+        task = display.add_task("rollouts", total=200, summary="")
+        display.update(task, completed=50, summary="50 ok")
+        time.sleep(0.3)  # no further update: the line repeats anyway
+    lines = stream.getvalue().splitlines()
+    assert len(lines) >= 2
+    assert re.fullmatch(
+        r"arrange-up evaluate: rollouts 50/200 \(25%\), about \d+:\d\d:\d\d left, 50 ok "
+        r"\[0:00:00 elapsed\]",
+        lines[0],
+    ), lines[0]
+    count = len(lines)
+    time.sleep(0.2)
+    assert len(stream.getvalue().splitlines()) == count  # stopped with the block
+    with shared.terminal_progress(TextColumn("x"), quiet=True) as display:
         assert display is None
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    with shared.terminal_progress(TextColumn("x"), quiet=True) as display:
+        assert display is None
+
+
+def test_the_interval_is_under_the_ten_seconds_the_docs_promise():
+    assert 0 < shared.PROGRESS_INTERVAL <= 10
 
 
 def test_the_progress_display_on_a_terminal_is_gone_after_the_block(monkeypatch):
