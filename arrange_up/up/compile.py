@@ -40,9 +40,9 @@ fingerprint of the UP content (a problem edited after compiling is refused rathe
 silently mapped back to the original); for one read by UP's ``PDDLReader`` by rebuilding it from
 the PDDL vocabulary (:mod:`arrange_up.io.pddl`).
 
-Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl` and
-the engines' modules (:mod:`arrange_up.up.engine_base`, :mod:`~arrange_up.up.engine_io` and one
-module per engine) import unified-planning.
+Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl`,
+:mod:`arrange_up.up.plan_writer` and the engines' modules (:mod:`arrange_up.up.engine_base`,
+:mod:`~arrange_up.up.engine_io` and one module per engine) import unified-planning.
 """
 
 from __future__ import annotations

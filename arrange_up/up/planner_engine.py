@@ -93,9 +93,14 @@ from arrange_up.up.engine_io import (
     metric_text,
     read_problem,
 )
+from arrange_up.up.plan_writer import install as install_plan_writer
 from arrange_up.up.registration import ENGINE_NAME
 
 __all__ = ["ArrangeUpPlanner"]
+
+# unified-planning's PDDLWriter (and so `up oneshot-planning --plan FILE`) writes the engine's
+# plans, whose actions have real parameters (arrange_up.up.plan_writer)
+install_plan_writer()
 
 
 class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):
