@@ -231,14 +231,27 @@ def _umask() -> int:
 MAX_DEPTH = 32
 
 
+#: The largest plan file read, in bytes, and the most actions it may hold: a plan has tens of
+#: actions of about 100 bytes each; the limits keep a runaway file (a million actions,
+#: ``/dev/zero``) from taking the memory and time of every command that reads plans.
+MAX_PLAN_BYTES = 16 * 2**20
+MAX_PLAN_ACTIONS = 10_000
+
+
 def _read_document(path: Path) -> Any:
     """The JSON value of a plan file, or :class:`PlanFileError` naming the place."""
     try:
-        data = path.read_bytes()
+        with open(path, "rb") as handle:
+            data = handle.read(MAX_PLAN_BYTES + 1)
     except IsADirectoryError:
         raise PlanFileError(f"{path}: is a directory; expected a plan file (JSON)") from None
     except OSError as error:
         raise PlanFileError(f"{path}: cannot read plan file: {error.strerror or error}") from None
+    if len(data) > MAX_PLAN_BYTES:
+        raise PlanFileError(
+            f"{path}: larger than {MAX_PLAN_BYTES // 2**20} MiB; expected a plan file (at most "
+            f"{MAX_PLAN_ACTIONS} actions, docs/plan-format.md)"
+        )
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
@@ -377,6 +390,11 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
     raw_actions = document["actions"]
     if not isinstance(raw_actions, list):
         raise PlanFileError(f"{path}: actions: expected a list, got {_json_kind(raw_actions)}")
+    if len(raw_actions) > MAX_PLAN_ACTIONS:
+        raise PlanFileError(
+            f"{path}: actions: {len(raw_actions)} actions; a plan file holds at most "
+            f"{MAX_PLAN_ACTIONS} (docs/plan-format.md)"
+        )
     try:
         actions = tuple(
             action_from_json(item, units, problem, f"{path}: actions[{i}]")

@@ -378,3 +378,17 @@ def test_an_atomic_write_writes_through_a_fifo_and_keeps_it(tmp_path):
     reader.join(timeout=10)
     assert received == ["through\n"]
     assert stat.S_ISFIFO(os.stat(fifo).st_mode)  # not replaced by a regular file
+
+
+def test_a_plan_file_too_large_or_with_too_many_actions_is_refused(tmp_path):
+    from arrange_up.io.planfile import MAX_PLAN_ACTIONS
+
+    problem = tiny("block-and-fixture")
+    zero = Path("/dev/zero")
+    if zero.exists():  # endless: read up to the limit, then refused
+        with pytest.raises(PlanFileError, match=r"^/dev/zero: larger than 16 MiB"):
+            read_plan(zero, problem)
+    many = document(problem, (ACTIONS[2],) * (MAX_PLAN_ACTIONS + 1))
+    path = write(tmp_path, many)
+    with pytest.raises(PlanFileError, match=rf"actions: {MAX_PLAN_ACTIONS + 1} actions; a plan"):
+        read_plan(path, problem)
