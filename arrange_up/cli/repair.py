@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import click
-from rich.progress import TextColumn
+from rich.progress import Progress, TextColumn
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
@@ -168,8 +168,9 @@ def repair(
                 line = _progress_line(info)
                 if display is None or task is None or line is None:
                     return
-                display.console.print(line, highlight=False)
-                display.update(task, description=line)
+                if isinstance(display, Progress):  # on a terminal: a line per step, as before
+                    display.console.print(line, highlight=False)
+                display.update(task, description=line)  # off it, the progress line repeats it
 
             result = repair_plan(
                 loaded,
