@@ -24,6 +24,7 @@ from arrange_up.cli.shared import (
     library_default,
     load_problem,
     parallel_options,
+    quiet_option,
     read_plan_file,
     seed_option,
     terminal_progress,
@@ -113,6 +114,7 @@ def _failure_lines(
 )
 @landing_option()
 @json_option("Print a machine-readable summary (JSON) on stdout.")
+@quiet_option()
 def evaluate(
     problem: str,
     plan_file: str,
@@ -124,6 +126,7 @@ def evaluate(
     record: str | None,
     landing: str,
     as_json: bool,
+    quiet: bool,
 ) -> None:
     """Estimate how reliably PLAN.json achieves PROBLEM's goal, by noisy rollouts.
 
@@ -153,10 +156,10 @@ def evaluate(
         TimeRemainingColumn(),
     )
     try:
-        with terminal_progress(*columns) as display:
+        with terminal_progress(*columns, what="evaluate", quiet=quiet) as display:
             update = None
             if display is not None:
-                task = display.add_task("evaluate", total=rollouts, summary="")
+                task = display.add_task("rollouts", total=rollouts, summary="")
 
                 def update(state: EvaluationProgress) -> None:
                     summary = f"{state.successes} ok ({100.0 * state.rate:.1f}%)"

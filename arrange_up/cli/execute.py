@@ -3,7 +3,10 @@ on the simulated executor (:mod:`arrange_up.execution`)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
+from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
 from arrange_up.cli.evaluate import _failure_lines
 from arrange_up.cli.shared import (
@@ -16,8 +19,10 @@ from arrange_up.cli.shared import (
     json_option,
     landing_option,
     load_problem,
+    quiet_option,
     read_plan_file,
     seed_option,
+    terminal_progress,
 )
 from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
@@ -122,6 +127,7 @@ _DEFAULTS = ClosedLoopSettings()
     help="The episode --storyboard draws (run again, traced: the same episode).",
 )
 @json_option("Print a machine-readable summary (JSON) on stdout.")
+@quiet_option()
 def execute(
     problem: str,
     plan_file: str | None,
@@ -141,6 +147,7 @@ def execute(
     storyboard: str | None,
     storyboard_episode: int,
     as_json: bool,
+    quiet: bool,
 ) -> None:
     """Execute a plan for PROBLEM closed loop: sense, update the belief, replan.
 
@@ -172,7 +179,12 @@ def execute(
     if plan_file is not None:
         actions, _ = read_plan_file(loaded, plan_file, warn_mismatch=True)
     else:
-        first = run_plan(loaded, semantics=semantics, particles=particles, seed=seed)
+        with terminal_progress(
+            TextColumn("{task.description}"), what="execute", quiet=quiet
+        ) as display:
+            if display is not None:
+                display.add_task(f"planning the first plan ({semantics})")
+            first = run_plan(loaded, semantics=semantics, particles=particles, seed=seed)
         if not first.solved:
             fail(f"no first plan: {first.reason}", EXIT_NEGATIVE)
         actions = first.actions or ()
@@ -189,16 +201,20 @@ def execute(
 
     finished: list[EpisodeRecord] = []
     read_back: set[int] = set()
+    episodes_display: Any = None  # the progress display, while the episodes run
+    episodes_task: Any = None
 
     def resume(numbers: tuple[int, ...]) -> None:
         read_back.update(numbers)
-        if not as_json:
+        if not as_json and not quiet:
             many = "episode" if len(numbers) == 1 else "episodes"
             click.echo(f"  resumed {len(numbers)} {many} from {record}", err=True)
 
     def report(episode: EpisodeRecord) -> None:
         finished.append(episode)
-        if not as_json and episode.episode not in read_back:
+        if episodes_display is not None and episodes_task is not None:
+            episodes_display.update(episodes_task, completed=len(finished))
+        if not as_json and not quiet and episode.episode not in read_back:
             outcome = "ok" if episode.success else str(episode.failure.kind)  # type: ignore[union-attr]
             click.echo(
                 f"  episode {episode.episode}: {outcome}, {episode.actions} actions, "
@@ -206,19 +222,26 @@ def execute(
                 err=True,
             )
 
+    episodes_columns = (TextColumn("episodes"), BarColumn(), MofNCompleteColumn())
     try:
-        result = run_episodes(
-            loaded,
-            actions,
-            sense=sense,
-            episodes=episodes,
-            seed=seed,
-            scale=noise_scale,
-            settings=settings,
-            record=record,
-            progress=report,
-            on_resume=resume,
-        )
+        with terminal_progress(*episodes_columns, what="execute", quiet=quiet) as episodes_display:
+            episodes_task = (
+                None
+                if episodes_display is None
+                else episodes_display.add_task("episodes", total=episodes)
+            )
+            result = run_episodes(
+                loaded,
+                actions,
+                sense=sense,
+                episodes=episodes,
+                seed=seed,
+                scale=noise_scale,
+                settings=settings,
+                record=record,
+                progress=report,
+                on_resume=resume,
+            )
     except KeyboardInterrupt:
         if record:
             kept = f"the finished episodes are in {record}: run again to resume"

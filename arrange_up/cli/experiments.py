@@ -15,7 +15,13 @@ from pathlib import Path
 from typing import Any
 
 import click
-from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+)
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
@@ -29,6 +35,7 @@ from arrange_up.cli.shared import (
     library_default,
     load_problem,
     parallel_options,
+    quiet_option,
     seed_option,
     terminal_progress,
     timeout_option,
@@ -101,31 +108,38 @@ class _Measurements:
     the elapsed time and, from the pace so far, the time left). ``opening`` (the duration
     estimate) is printed before the first of them: the experiment reports its first stage only
     after it has accepted its CSV, so a CSV it refuses is not preceded by an estimate of work
-    that will not be done."""
+    that will not be done. On a terminal the lines go above the live display; otherwise they
+    are lines on stderr, and the display (a :class:`~arrange_up.cli.shared.LineProgress`)
+    repeats the current stage every few seconds while a measurement runs; ``quiet``: nothing."""
 
-    def __init__(self, display: Any, total: int, opening: str) -> None:
+    def __init__(self, display: Any, total: int, opening: str, quiet: bool = False) -> None:
         self.display, self.total, self.count = display, total, 0
+        self.quiet = quiet
+        self.live = isinstance(display, Progress)
         self.opening: str | None = opening
         self.started = time.perf_counter()
         self.task = display.add_task("starting", total=total) if display is not None else None
 
+    def _print(self, line: str) -> None:
+        if self.quiet:
+            return
+        if self.live:
+            self.display.console.print(f"[{time.strftime('%H:%M:%S')}] {line}", highlight=False)
+        else:
+            _say(line)
+
     def _open(self) -> None:
         if self.opening is None:
             return
-        if self.display is None:
-            _say(self.opening)
-        else:
-            self.display.console.print(
-                f"[{time.strftime('%H:%M:%S')}] {self.opening}", highlight=False
-            )
+        self._print(self.opening)
         self.opening = None
 
     def say(self, message: str) -> None:
         self._open()
-        if self.display is None:
-            _say(message)
-        else:
+        if self.display is not None:
             self.display.update(self.task, description=message)
+        if not self.live:
+            self._print(message)
 
     def done(self, line: str) -> None:
         self._open()
@@ -135,25 +149,26 @@ class _Measurements:
         pace = f"{self.count}/{self.total} done, {costs.format_duration(elapsed)} elapsed"
         if self.count < self.total:
             pace += f", about {costs.format_duration(left)} left"
-        if self.display is None:
-            _say(f"{line} [{pace}]")
-        else:
-            self.display.console.print(f"[{time.strftime('%H:%M:%S')}] {line}", highlight=False)
+        self._print(line if self.live else f"{line} [{pace}]")
+        if self.display is not None:
             self.display.update(self.task, completed=self.count)
 
 
 @contextmanager
-def _measurements(estimate: costs.Estimate, total: int) -> Iterator[_Measurements]:
-    """Report each measurement (the CLI's progress display on a terminal, lines on stderr
-    otherwise), after the duration estimate."""
+def _measurements(
+    estimate: costs.Estimate, total: int, what: str, quiet: bool = False
+) -> Iterator[_Measurements]:
+    """Report each measurement of the experiment ``what`` (the CLI's progress display on a
+    terminal, lines on stderr otherwise, nothing when ``quiet``), after the duration
+    estimate."""
     columns = (
         TextColumn("{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
     )
-    with terminal_progress(*columns) as display:
-        yield _Measurements(display, total, f"estimate: {estimate.describe(total)}")
+    with terminal_progress(*columns, what=f"experiment {what}", quiet=quiet) as display:
+        yield _Measurements(display, total, f"estimate: {estimate.describe(total)}", quiet)
 
 
 def _transition_line(row: dict[str, Any]) -> str:
@@ -266,6 +281,7 @@ def _output_dir_option(csv: str) -> Any:
 )
 @_controller_option
 @_output_dir_option("transition-comparison.csv")
+@quiet_option()
 def experiment_transition_comparison(
     problems: str,
     particle_counts: str,
@@ -277,6 +293,7 @@ def experiment_transition_comparison(
     workers: int | None,
     controller: str | None,
     output_dir: str,
+    quiet: bool,
 ) -> None:
     """Figures 3-6 and 3-7: planning time and reliability of each belief transition.
 
@@ -317,7 +334,7 @@ def experiment_transition_comparison(
         total = None if planning is None or evaluation is None else planning + evaluation
         estimate.add(total, f"{name} {label}")
     try:
-        with _measurements(estimate, len(pending)) as report:
+        with _measurements(estimate, len(pending), "transition-comparison", quiet) as report:
             path = transition_comparison(
                 Path(output_dir),
                 problems=names,
@@ -377,6 +394,7 @@ def experiment_transition_comparison(
 @timeout_option("Time limit per search, seconds.")
 @_controller_option
 @_output_dir_option("search-table.csv")
+@quiet_option()
 def experiment_search_table(
     problems: str,
     semantics: str | None,
@@ -386,6 +404,7 @@ def experiment_search_table(
     timeout: float | None,
     controller: str | None,
     output_dir: str,
+    quiet: bool,
 ) -> None:
     """Table 3.1: nodes expanded and plan cost for each heuristic, with and without
     domination.
@@ -420,7 +439,7 @@ def experiment_search_table(
             cost = None  # measured with one particle and A* only
         estimate.add(cost, f"{SEARCH_TYPES[k][0]} {name}")
     try:
-        with _measurements(estimate, len(pending)) as report:
+        with _measurements(estimate, len(pending), "search-table", quiet) as report:
             path = search_table(
                 Path(output_dir),
                 problems=names,
@@ -498,6 +517,7 @@ def experiment_search_table(
     show_default=True,
     help="Where fixtures.csv and the PNGs go; a fixtures.csv already there is resumed.",
 )
+@quiet_option()
 def experiment_fixtures(
     problems: str,
     plans: int,
@@ -512,6 +532,7 @@ def experiment_fixtures(
     backend: str | None,
     scheduler: str | None,
     output_dir: str,
+    quiet: bool,
 ) -> None:
     """Figures 4-14 to 4-25: reliability of nominal plans before and after fixture repair.
 
@@ -573,7 +594,7 @@ def experiment_fixtures(
     for name, count, stage in pending:
         estimate.add(costs.fixture_cost(name, count, rollouts, fixtures=stage != "ablation"), name)
     try:
-        with _measurements(estimate, len(pending)) as report:
+        with _measurements(estimate, len(pending), "fixtures", quiet) as report:
             path = fixture_experiment(
                 Path(output_dir),
                 problems=names,

@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from arrange_up.cli.shared import OutputFile, fail, seed_option
+from arrange_up.cli.shared import OutputFile, fail, seed_option, writing_output
 from arrange_up.io.generate import (
     BLOCKS_NOISE,
     FAMILIES,
@@ -144,5 +144,6 @@ def generate(
     if output is None:
         click.echo(text, nl=False)
         return
-    write_text_atomic(Path(output), text)
+    with writing_output(output):
+        write_text_atomic(Path(output), text)
     click.echo(f"wrote {output}: {problem.name} ({parts} parts)")

@@ -24,9 +24,10 @@ from arrange_up.cli.shared import (
     library_default,
     load_problem,
     parallel_options,
+    quiet_option,
     seed_option,
     terminal_progress,
-    timeout_option,
+    writing_output,
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
@@ -35,6 +36,10 @@ from arrange_up.planning.config import DEFAULT_MAX_NODES, DEFAULT_WEIGHT, PlanCo
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import plan as run_plan
 from arrange_up.planning.validation import check_validate
+
+#: ``plan --timeout``'s default, in seconds: a run is not left going for hours unattended
+#: (docs/design/cli.md).
+DEFAULT_PLAN_TIMEOUT = 600.0
 
 
 def _status_line(stats: dict[str, Any]) -> str:
@@ -95,8 +100,14 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     default=None,
     help=f"Node limit (default: the problem's planning.max_nodes, else {DEFAULT_MAX_NODES}).",
 )
-@timeout_option(
-    "Give up after this many seconds (validation included: a plan found in time is kept)."
+@click.option(
+    "--timeout",
+    type=FiniteFloat(0, None, min_open=True),
+    default=DEFAULT_PLAN_TIMEOUT,
+    show_default=True,
+    help="Give up after this many seconds (validation included: a plan found in time is "
+    f"kept). The default, {DEFAULT_PLAN_TIMEOUT:g} s ({DEFAULT_PLAN_TIMEOUT / 60:g} minutes), "
+    "ends a run that would otherwise go on for hours; raise it for larger problems.",
 )
 @click.option(
     "--heuristic",
@@ -146,6 +157,7 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     help="Write the plan file (JSON, documented in docs/plan-format.md).",
 )
 @json_option("Print a machine-readable summary (JSON) on stdout instead of the table.")
+@quiet_option()
 def plan(
     problem: str,
     semantics: str,
@@ -164,6 +176,7 @@ def plan(
     model: str | None,
     output: str | None,
     as_json: bool,
+    quiet: bool,
 ) -> None:
     """Search belief space for a conformant plan for PROBLEM.
 
@@ -192,6 +205,9 @@ def plan(
     --output like any other); during a validation, the plan found is kept with the rollouts
     already run. A second Ctrl-C aborts at once and writes nothing.
 
+    Progress: a live line on a terminal; otherwise (a log, CI) a line on stderr every few
+    seconds with the search's state and the time elapsed; --quiet prints neither.
+
     Exit status: 0 a plan was found, 1 none was found (node limit, timeout, exhausted: the
     candidates ran out, unsolvable: proven, e.g. a goal part larger than the table, cancelled:
     interrupted) or aborted, 2 bad input. An unsolved run prints one line of why.
@@ -210,7 +226,9 @@ def plan(
     try:
         with (
             first_interrupt_stops("the planning run (a plan already found is kept)") as interrupted,
-            terminal_progress(TextColumn("{task.description}")) as display,
+            terminal_progress(
+                TextColumn("{task.description}"), what="plan", quiet=quiet
+            ) as display,
         ):
             update = None
             if display is not None:
@@ -246,7 +264,8 @@ def plan(
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
     document = result.document(loaded, model)
     if output:
-        write_json_atomic(Path(output), document)
+        with writing_output(output):
+            write_json_atomic(Path(output), document)
     if as_json:
         plan_length = len(result.actions) if result.actions is not None else None
         echo_json(document_summary(document, output, plan_length=plan_length, reason=result.reason))

@@ -7,7 +7,14 @@ from pathlib import Path
 
 import click
 
-from arrange_up.cli.shared import EXIT_BAD_INPUT, EXIT_NEGATIVE, OutputFile, fail, load_problem
+from arrange_up.cli.shared import (
+    EXIT_BAD_INPUT,
+    EXIT_NEGATIVE,
+    OutputFile,
+    fail,
+    load_problem,
+    writing_output,
+)
 from arrange_up.io.domains import (
     UnknownDomainError,
     check_problem_file,
@@ -158,7 +165,8 @@ def export(problem: str, fmt: str, output: str) -> None:
         text = write_pddl_problem(loaded)
     except PddlExportError as error:
         fail(str(error), EXIT_NEGATIVE)
-    write_text_atomic(Path(output), text)
+    with writing_output(output):
+        write_text_atomic(Path(output), text)
     click.echo(f"wrote {output}")
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+from rich.progress import Progress, TextColumn
 
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
@@ -18,8 +19,11 @@ from arrange_up.cli.shared import (
     json_option,
     library_default,
     load_problem,
+    quiet_option,
     read_plan_file,
     seed_option,
+    terminal_progress,
+    writing_output,
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
@@ -33,19 +37,17 @@ from arrange_up.repair import (
 )
 
 
-def _echo_progress(info: dict[str, Any]) -> None:
-    """One line on stderr per repaired step, and one when a push's candidates are scored."""
+def _progress_line(info: dict[str, Any]) -> str | None:
+    """The line of a repair progress report: one per repaired step, and one when a push's
+    candidates are scored; None for other reports."""
     if info["phase"] == "done":
-        click.echo(
+        return (
             f"step {info['step']}/{info['steps']} {info['kind']}: {info['choice']} "
-            f"({info['elapsed']:.1f} s)",
-            err=True,
+            f"({info['elapsed']:.1f} s)"
         )
-    elif info["phase"] == "placements":
-        click.echo(
-            f"step {info['step']}/{info['steps']} push: scoring {info['candidates']} candidates…",
-            err=True,
-        )
+    if info["phase"] == "placements":
+        return f"step {info['step']}/{info['steps']} push: scoring {info['candidates']} candidates…"
+    return None
 
 
 def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
@@ -120,6 +122,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     "'repair').",
 )
 @json_option("Print a machine-readable summary (JSON) on stdout instead of the table.")
+@quiet_option()
 def repair(
     problem: str,
     plan_file: str | None,
@@ -130,6 +133,7 @@ def repair(
     workers: int | None,
     output: str | None,
     as_json: bool,
+    quiet: bool,
 ) -> None:
     """Make a nominal plan for PROBLEM robust by placing fixtures (thesis ch. 4).
 
@@ -149,29 +153,43 @@ def repair(
     loaded = load_problem(problem)
     if plan_file is not None:
         nominal, _ = read_plan_file(loaded, plan_file, warn_mismatch=False)
-    else:
-        found = nominal_plans(loaded, 1, seed)
-        if not found:
-            fail("the deterministic planner found no nominal plan to repair", EXIT_NEGATIVE)
-        nominal = found[0]
     try:
-        result = repair_plan(
-            loaded,
-            nominal,
-            particles=particles,
-            seed=seed,
-            method=method,
-            workers=available_cores() if workers is None else workers,
-            progress=_echo_progress if sys.stderr.isatty() else None,
-            fixtures=not no_fixtures,
-        )
+        with terminal_progress(
+            TextColumn("{task.description}"), what="repair", quiet=quiet
+        ) as display:
+            task = None if display is None else display.add_task("finding a nominal plan")
+            if plan_file is None:
+                found = nominal_plans(loaded, 1, seed)
+                if not found:
+                    fail("the deterministic planner found no nominal plan to repair", EXIT_NEGATIVE)
+                nominal = found[0]
+
+            def progress(info: dict[str, Any]) -> None:
+                line = _progress_line(info)
+                if display is None or task is None or line is None:
+                    return
+                if isinstance(display, Progress):  # on a terminal: a line per step, as before
+                    display.console.print(line, highlight=False)
+                display.update(task, description=line)  # off it, the progress line repeats it
+
+            result = repair_plan(
+                loaded,
+                nominal,
+                particles=particles,
+                seed=seed,
+                method=method,
+                workers=available_cores() if workers is None else workers,
+                progress=progress,
+                fixtures=not no_fixtures,
+            )
     except KeyboardInterrupt:
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
     except ValueError as error:
         fail(str(error))
     document = result.document(loaded)
     if output:
-        write_json_atomic(Path(output), document)
+        with writing_output(output):
+            write_json_atomic(Path(output), document)
     if as_json:
         echo_json(document_summary(document, output, reason=result.reason or None))
     else:

@@ -19,6 +19,7 @@ import signal
 import sys
 import tempfile
 import threading
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -26,7 +27,7 @@ from typing import Any, NoReturn
 
 import click
 from rich.console import Console
-from rich.progress import Progress, ProgressColumn
+from rich.progress import Progress, ProgressColumn, TaskID
 
 from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.io.domains import UnknownDomainError, load_checked
@@ -45,6 +46,16 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
     """Print ``arrange-up: message`` on stderr and exit with ``code`` (default: bad input)."""
     click.echo(f"arrange-up: {message}", err=True)
     sys.exit(code)
+
+
+@contextmanager
+def writing_output(output: str | os.PathLike[str]) -> Iterator[None]:
+    """Around writing the file ``-o output``: an ``OSError`` (a full disk, ``/dev/full``, a
+    directory) ends the command with one line naming the file, exit status 2."""
+    try:
+        yield
+    except OSError as error:
+        fail(f"{os.fsdecode(output)}: cannot write: {error.strerror or error}")
 
 
 #: A seed: a non-negative integer (numpy's seed sequences refuse negative ones).
@@ -263,17 +274,153 @@ def backend_choice(backend: str | None, scheduler: str | None) -> str:
     return backend or ("dask" if scheduler is not None else "local")
 
 
+#: How often, in seconds, a long command prints its progress line on stderr when stderr is not a
+#: terminal (a log, CI, a notebook, a launch file): under the 10 s that docs/design/cli.md
+#: promises.
+PROGRESS_INTERVAL = 9.0
+
+
 @contextmanager
-def terminal_progress(*columns: str | ProgressColumn) -> Iterator[Progress | None]:
-    """A transient rich progress display with ``columns`` on stderr while the block runs, or
-    None when stderr is not a terminal (nothing is drawn into pipes, files or tests). The
-    display is gone when the block exits, so messages printed after it (e.g. on an interrupt)
-    are not overdrawn."""
-    if not sys.stderr.isatty():
+def terminal_progress(
+    *columns: str | ProgressColumn, what: str = "", quiet: bool = False
+) -> Iterator[Progress | LineProgress | None]:
+    """The progress display of a long command (``what`` names it in lines: "plan") while the
+    block runs:
+
+    * stderr is a terminal: a transient rich display with ``columns``, gone when the block
+      exits (messages printed after it, e.g. on an interrupt, are not overdrawn);
+    * it is not: a :class:`LineProgress`, one line on stderr every
+      :data:`PROGRESS_INTERVAL` seconds (what, how far, elapsed, an estimate of the time left
+      where the total is known);
+    * ``quiet``: None, nothing is shown.
+
+    Both displays take ``add_task``, ``update`` and ``console.print`` alike."""
+    if quiet:
         yield None
+        return
+    if not sys.stderr.isatty():
+        lines = LineProgress(what)
+        try:
+            yield lines
+        finally:
+            lines.stop()
         return
     with Progress(*columns, console=Console(stderr=True), transient=True) as display:
         yield display
+
+
+class LineProgress:
+    """Progress as plain lines on stderr, for when it is not a terminal: the subset of rich's
+    ``Progress`` the commands use (``add_task``, ``update``, ``console.print``), and a daemon
+    thread that prints the state of the tasks every ``interval`` seconds until :meth:`stop`,
+    whether or not anything was updated in between (a search can run minutes between two
+    callbacks)."""
+
+    def __init__(self, what: str, interval: float | None = None) -> None:
+        self.what = what
+        self.console = _StderrConsole()
+        self._tasks: list[dict[str, Any]] = []
+        self._lock = threading.Lock()
+        self._started = time.monotonic()
+        self._stopped = threading.Event()
+        self._interval = PROGRESS_INTERVAL if interval is None else interval
+        self._thread = threading.Thread(target=self._beat, name="progress-lines", daemon=True)
+        self._thread.start()
+
+    def add_task(self, description: str, total: float | None = None, **fields: Any) -> TaskID:
+        with self._lock:
+            self._tasks.append(
+                {
+                    "description": description,
+                    "total": total,
+                    "completed": 0,
+                    "fields": dict(fields),
+                    "started": time.monotonic(),
+                }
+            )
+            return TaskID(len(self._tasks) - 1)
+
+    def update(
+        self,
+        task: TaskID,
+        *,
+        description: str | None = None,
+        total: float | None = None,
+        completed: float | None = None,
+        advance: float | None = None,
+        **fields: Any,
+    ) -> None:
+        with self._lock:
+            state = self._tasks[task]
+            if description is not None:
+                state["description"] = description
+            if total is not None:
+                state["total"] = total
+            if completed is not None:
+                state["completed"] = completed
+            if advance is not None:
+                state["completed"] += advance
+            state["fields"].update(fields)
+
+    def line(self) -> str:
+        """The progress line: each task's description, count and estimate, and the time
+        elapsed since the command began."""
+        now = time.monotonic()
+        with self._lock:
+            parts = [_task_text(state, now) for state in self._tasks]
+        elapsed = _clock(now - self._started)
+        head = f"arrange-up {self.what}: " if self.what else "arrange-up: "
+        return head + "; ".join(parts or ["starting"]) + f" [{elapsed} elapsed]"
+
+    def stop(self) -> None:
+        self._stopped.set()
+        self._thread.join(timeout=1.0)
+
+    def _beat(self) -> None:
+        while not self._stopped.wait(self._interval):
+            self.console.print(self.line())
+
+
+class _StderrConsole:
+    """``console.print`` of :class:`LineProgress`: the text as one line on stderr."""
+
+    _lock = threading.Lock()
+
+    def print(self, text: str, **_: Any) -> None:
+        with self._lock:
+            sys.stderr.write(f"{text}\n")
+            sys.stderr.flush()
+
+
+def _task_text(state: dict[str, Any], now: float) -> str:
+    text = " ".join(str(state["description"]).split())  # a terminal line's padding, squeezed
+    done, total = state["completed"], state["total"]
+    if total:
+        text += f" {done:g}/{total:g} ({100.0 * done / total:.0f}%)"
+        if 0 < done < total:
+            left = (now - state["started"]) / done * (total - done)
+            text += f", about {_clock(left)} left"
+    summary = state["fields"].get("summary")
+    if summary:
+        text += f", {summary}"
+    return text
+
+
+def _clock(seconds: float) -> str:
+    """``h:mm:ss``."""
+    whole = int(max(0.0, seconds))
+    return f"{whole // 3600}:{whole % 3600 // 60:02d}:{whole % 60:02d}"
+
+
+def quiet_option() -> Callable[[Any], Any]:
+    """``--quiet``: no progress display or progress lines on stderr."""
+    return click.option(
+        "--quiet",
+        "-q",
+        is_flag=True,
+        help="Print no progress on stderr (by default a live display on a terminal, else a "
+        f"line every {PROGRESS_INTERVAL:g} s).",
+    )
 
 
 @contextmanager

@@ -29,6 +29,7 @@ from arrange_up.cli.shared import (
     json_option,
     library_default,
     parallel_options,
+    quiet_option,
     seed_option,
     terminal_progress,
 )
@@ -147,6 +148,7 @@ def _echo_scores(scores: dict) -> None:
     help="Resumable .jsonl file of the test set (default OUTPUT_DIR/NAME.test.jsonl).",
 )
 @json_option("Print the model card (JSON) on stdout.")
+@quiet_option()
 def train_cbst(
     examples: int,
     rollouts_per_example: int,
@@ -163,6 +165,7 @@ def train_cbst(
     data_path: str | None,
     test_data_path: str | None,
     as_json: bool,
+    quiet: bool,
 ) -> None:
     """Generate CBST training data, then tune, evaluate and save its push model (thesis §3.2).
 
@@ -176,7 +179,7 @@ def train_cbst(
     """
     backend = backend_choice(backend, scheduler)
     try:
-        with terminal_progress(*_TRAIN_COLUMNS) as display:
+        with terminal_progress(*_TRAIN_COLUMNS, what="train-cbst", quiet=quiet) as display:
             card = run_training(
                 examples=examples,
                 rollouts_per_example=rollouts_per_example,
@@ -248,6 +251,7 @@ def train_cbst(
 @parallel_options("examples")
 @click.option("--write", is_flag=True, help="Replace the card's scores with the new ones.")
 @json_option("Print the scores (JSON) on stdout.")
+@quiet_option()
 def rescore_cbst(
     model: str,
     data_path: str,
@@ -259,6 +263,7 @@ def rescore_cbst(
     scheduler: str | None,
     write: bool,
     as_json: bool,
+    quiet: bool,
 ) -> None:
     """Measure a saved CBST MODEL's 8-fold CV and fresh-test scores again.
 
@@ -272,7 +277,7 @@ def rescore_cbst(
     """
     backend = backend_choice(backend, scheduler)
     try:
-        with terminal_progress(*_TRAIN_COLUMNS) as display:
+        with terminal_progress(*_TRAIN_COLUMNS, what="rescore-cbst", quiet=quiet) as display:
             scores = rescore_model(
                 model,
                 data_path=data_path,

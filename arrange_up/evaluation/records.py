@@ -88,9 +88,10 @@ def _dig(data: Any, path: tuple[str, ...]) -> Any:
 _DIMENSIONS = frozenset(("x", "y", "theta", "off table", "on table"))
 
 
-def _record_problem(data: Any, actions: Any) -> str | None:
+def rollout_line_problem(data: Any, actions: Any, of: str | None = None) -> str | None:
     """What is wrong with the JSON ``data`` of one rollout line of a plan of ``actions``
-    actions, or ``None``. ``RolloutRecord.from_json`` checks the rollout index, the success
+    actions, or ``None`` (``of`` says what the actions are in a message: by default "the
+    plan's N"). ``RolloutRecord.from_json`` checks the rollout index, the success
     flag and the failure kind; this checks the rest against the plan, so that a resumed
     evaluation never counts a line no rollout of this plan could have written."""
     if not isinstance(data, dict):
@@ -113,10 +114,8 @@ def _record_problem(data: Any, actions: Any) -> str | None:
         if action is not None:
             return f"failure.action: a missed goal names no action, got {action!r}"
     elif not is_integer(action) or not 0 <= action < (actions if is_integer(actions) else 0):
-        return (
-            f"failure.action: expected the 0-based index of an action of the plan's {actions}, "
-            f"got {action!r}"
-        )
+        whose = f"the plan's {actions}" if of is None else of
+        return f"failure.action: expected the 0-based index of an action of {whose}, got {action!r}"
     for key in ("reason", "detail"):
         if failure.get(key) is not None and not isinstance(failure[key], str):
             return f"failure.{key}: expected text, got {failure[key]!r}"
@@ -189,7 +188,7 @@ class RecordFile:
         def parse(line: bytes, number: int) -> RolloutRecord:
             try:
                 data = json.loads(line)
-                problem = _record_problem(data, actions)
+                problem = rollout_line_problem(data, actions)
                 record = None if problem else RolloutRecord.from_json(data)
             except (ValueError, KeyError, TypeError) as error:
                 problem = str(error)

@@ -27,8 +27,9 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.belief.compiled import compile_problem
+from arrange_up.counts import is_integer
 from arrange_up.evaluation.outcomes import Failure, RolloutRecord
-from arrange_up.evaluation.records import RecordFileError, plan_hash
+from arrange_up.evaluation.records import RecordFileError, plan_hash, rollout_line_problem
 from arrange_up.evaluation.reliability import FailureBreakdown, Reliability
 from arrange_up.execution.belief import ModelFailure
 from arrange_up.execution.executor import SimulatedExecutor
@@ -224,6 +225,30 @@ def _header(
     }
 
 
+def _no_constant(name: str) -> Any:
+    """``json.loads``' hook for ``NaN``, ``Infinity`` and ``-Infinity``, which no record holds
+    (Python's reader accepts them; ``Infinity`` actions overflowed an ``int``)."""
+    raise ValueError(f"{name} is not a number a record holds")
+
+
+def _episode_problem(data: Any, max_actions: Any) -> str | None:
+    """What is wrong with the JSON ``data`` of one episode line, or None: the count of actions
+    executed must be within the run's ``max_actions``, and a failed action one of them or the
+    one that failed (the same checks as a rollout line's, :func:`rollout_line_problem`)."""
+    if not isinstance(data, dict):
+        return f"expected a JSON object, got {type(data).__name__}"
+    actions = data.get("actions")
+    if not is_integer(actions) or not 0 <= actions <= max_actions:
+        return (
+            f"actions: expected the number of actions executed, 0 to {max_actions}, got {actions!r}"
+        )
+    rollout = {"rollout": data.get("episode"), "success": data.get("success"), **_failure(data)}
+    # the failed action is the one being executed: index `actions` at most
+    return rollout_line_problem(
+        rollout, actions + 1, f"the {actions} executed or the one that failed"
+    )
+
+
 def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, EpisodeRecord]]:
     """The record file opened for appending and locked, with the episodes it holds."""
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -248,11 +273,17 @@ def _open_record(path: Path, header: dict[str, Any]) -> tuple[Any, dict[int, Epi
                 "another file"
             )
 
+        max_actions = header["settings"]["max_actions"]
+
         def parse(line: bytes, number: int) -> EpisodeRecord:
             try:
-                return EpisodeRecord.from_json(json.loads(line))
-            except (ValueError, KeyError, TypeError) as error:
-                raise RecordFileError(f"{path}:{number}: not an episode record: {error}") from None
+                data = json.loads(line, parse_constant=_no_constant)
+                problem = _episode_problem(data, max_actions)
+                if problem is None:
+                    return EpisodeRecord.from_json(data)
+            except (ValueError, KeyError, TypeError, OverflowError) as error:
+                problem = str(error)
+            raise RecordFileError(f"{path}:{number}: not an episode record: {problem}")
 
         episodes = numbered_records(
             lines, path, parse, lambda r: r.episode, "episode", RecordFileError

@@ -6,6 +6,8 @@ records by number (one recorded twice with different outcomes refused)."""
 from __future__ import annotations
 
 import json
+import os
+import stat
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import IO, TypeVar
@@ -73,6 +75,12 @@ def recorded_lines(
     ``error`` (the caller's exception class) *before anything is truncated*: it is someone
     else's file (a plan, notes, another kind of record), and nothing of it may be lost. Shared
     by the rollout records, the closed loop's episode records and CBST's training data."""
+    if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+        # /dev/null, a FIFO: nothing can be read back to resume, and truncating fails
+        raise error(
+            f"{path}: not a regular file; a record is read back to resume a run, so it must be "
+            "a file: use another record file"
+        )
     handle.seek(0)
     data = handle.read()
     *complete, cut = data.split(b"\n")

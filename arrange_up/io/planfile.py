@@ -30,16 +30,19 @@ was made before plan files recorded it, when every problem was driven by the ser
 from __future__ import annotations
 
 import dataclasses
+import errno
 import json
 import math
 import os
+import re
+import stat
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeGuard
 
 from arrange_up.counts import is_number
-from arrange_up.io.files import undecodable_place
+from arrange_up.io.files import text_place, undecodable_place
 from arrange_up.io.validation import angle_problem
 from arrange_up.io.yaml_settings import SERVO_KEYS, controller_factors
 from arrange_up.io.yaml_source import long_number
@@ -186,8 +189,22 @@ def write_json_atomic(path: Path, document: Mapping[str, Any]) -> Path:
 def write_text_atomic(path: Path, text: str) -> Path:
     """Write ``text`` to ``path`` through a temporary file and a rename, so that a reader (or
     a crash) never leaves a half-written file behind. The file gets the permissions of any
-    newly created file (``0o666`` less the umask), not the temporary file's private ``0o600``."""
+    newly created file (``0o666`` less the umask), not the temporary file's private ``0o600``.
+
+    A symbolic link is written through: its target gets the text (atomically, as above) and
+    the link stays. A path that is neither a regular file nor missing (a FIFO, a device such as
+    ``/dev/stdout``) is written through as well, directly, since a rename would replace the
+    special file with a regular one; a directory raises ``IsADirectoryError``. Raises
+    ``OSError`` when the text cannot be written (``/dev/full``, a full disk)."""
     path = Path(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if path.exists() and not stat.S_ISREG(path.stat().st_mode):
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        return path
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
@@ -214,14 +231,27 @@ def _umask() -> int:
 MAX_DEPTH = 32
 
 
+#: The largest plan file read, in bytes, and the most actions it may hold: a plan has tens of
+#: actions of about 100 bytes each; the limits keep a runaway file (a million actions,
+#: ``/dev/zero``) from taking the memory and time of every command that reads plans.
+MAX_PLAN_BYTES = 16 * 2**20
+MAX_PLAN_ACTIONS = 10_000
+
+
 def _read_document(path: Path) -> Any:
     """The JSON value of a plan file, or :class:`PlanFileError` naming the place."""
     try:
-        data = path.read_bytes()
+        with open(path, "rb") as handle:
+            data = handle.read(MAX_PLAN_BYTES + 1)
     except IsADirectoryError:
         raise PlanFileError(f"{path}: is a directory; expected a plan file (JSON)") from None
     except OSError as error:
         raise PlanFileError(f"{path}: cannot read plan file: {error.strerror or error}") from None
+    if len(data) > MAX_PLAN_BYTES:
+        raise PlanFileError(
+            f"{path}: larger than {MAX_PLAN_BYTES // 2**20} MiB; expected a plan file (at most "
+            f"{MAX_PLAN_ACTIONS} actions, docs/plan-format.md)"
+        )
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
@@ -230,14 +260,22 @@ def _read_document(path: Path) -> Any:
             f"{path}:{line}:{column}: not a text file: byte 0x{data[error.start]:02x} is not "
             "UTF-8; expected a plan file (JSON in UTF-8)"
         ) from None
-    depth = _nesting(text)
-    if depth > MAX_DEPTH:
+    too_deep = _too_deep(text)
+    if too_deep is not None:
+        line, column = text_place(text, too_deep)
         raise PlanFileError(
-            f"{path}: nested {depth} levels deep; expected a plan file (JSON nested at most "
-            f"{MAX_DEPTH} levels)"
+            f"{path}:{line}:{column}: nested too deeply; expected a plan file (JSON nested at "
+            f"most {MAX_DEPTH} levels)"
         )
     try:
-        return json.loads(text)
+        return json.loads(text, object_pairs_hook=_unique_keys)
+    except _DuplicateKey as duplicate:
+        line, column = _second_key_place(text, duplicate.key)
+        raise PlanFileError(
+            f"{path}:{line}:{column}: key {json.dumps(duplicate.key)} appears twice in one "
+            "object; a plan file names each key once (JSON readers disagree on which copy "
+            "wins)"
+        ) from None
     except json.JSONDecodeError as error:
         raise PlanFileError(
             f"{path}:{error.lineno}:{error.colno}: not JSON: {error.msg}; expected a plan "
@@ -253,11 +291,12 @@ def _read_document(path: Path) -> Any:
         ) from None
 
 
-def _nesting(text: str) -> int:
-    """How deeply the brackets of JSON ``text`` nest (brackets inside strings not counted)."""
-    depth = deepest = 0
+def _too_deep(text: str) -> int | None:
+    """The index of the first bracket of JSON ``text`` nested deeper than :data:`MAX_DEPTH`
+    (brackets inside strings not counted), or None."""
+    depth = 0
     in_string = escaped = False
-    for char in text:
+    for index, char in enumerate(text):
         if in_string:
             if escaped:
                 escaped = False
@@ -269,10 +308,35 @@ def _nesting(text: str) -> int:
             in_string = True
         elif char in "[{":
             depth += 1
-            deepest = max(deepest, depth)
+            if depth > MAX_DEPTH:
+                return index
         elif char in "]}":
             depth -= 1
-    return deepest
+    return None
+
+
+class _DuplicateKey(ValueError):
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``json.loads``' object hook: the object, or :class:`_DuplicateKey` for a repeated key."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
+
+
+def _second_key_place(text: str, key: str) -> tuple[int, int]:
+    """Line and column of the second place ``key`` is written as an object key in ``text``
+    (the file's start when it cannot be told: the key written with escapes)."""
+    pattern = re.compile(re.escape(json.dumps(key)) + r"\s*:")
+    found = list(pattern.finditer(text))
+    return text_place(text, found[1].start()) if len(found) > 1 else (1, 1)
 
 
 def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Action, ...], dict]:
@@ -326,6 +390,11 @@ def read_plan(path: str | Path, problem: ArrangementProblem) -> tuple[tuple[Acti
     raw_actions = document["actions"]
     if not isinstance(raw_actions, list):
         raise PlanFileError(f"{path}: actions: expected a list, got {_json_kind(raw_actions)}")
+    if len(raw_actions) > MAX_PLAN_ACTIONS:
+        raise PlanFileError(
+            f"{path}: actions: {len(raw_actions)} actions; a plan file holds at most "
+            f"{MAX_PLAN_ACTIONS} (docs/plan-format.md)"
+        )
     try:
         actions = tuple(
             action_from_json(item, units, problem, f"{path}: actions[{i}]")

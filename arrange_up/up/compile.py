@@ -40,9 +40,9 @@ fingerprint of the UP content (a problem edited after compiling is refused rathe
 silently mapped back to the original); for one read by UP's ``PDDLReader`` by rebuilding it from
 the PDDL vocabulary (:mod:`arrange_up.io.pddl`).
 
-Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl` and
-the engines' modules (:mod:`arrange_up.up.engine_base`, :mod:`~arrange_up.up.engine_io` and one
-module per engine) import unified-planning.
+Only this module, :mod:`arrange_up.up.effects`, :mod:`arrange_up.io.pddl`,
+:mod:`arrange_up.up.plan_writer` and the engines' modules (:mod:`arrange_up.up.engine_base`,
+:mod:`~arrange_up.up.engine_io` and one module per engine) import unified-planning.
 """
 
 from __future__ import annotations
@@ -52,6 +52,7 @@ import hashlib
 import math
 import re
 from collections.abc import Sequence
+from fractions import Fraction
 from typing import Any
 
 import unified_planning.model as m
@@ -76,11 +77,13 @@ from arrange_up.up.effects import (
 
 __all__ = [
     "ACTION_NAMES",
+    "ARRANGE_UP_CORE_KIND",
     "FLUENT_NAMES",
     "NOMINAL_SEMANTICS",
     "READABLE_KIND",
     "TO_UP_KIND",
     "TYPE_NAMES",
+    "equip_pddl_problem",
     "from_up",
     "made_by_to_up",
     "plan_from_up",
@@ -116,6 +119,22 @@ TO_UP_KIND = _kind()
 #: fluents whose initial value may be undefined). A problem with any other feature (integer or
 #: object fluents, durative actions, scheduling, hierarchies, ...) is not an arrange-up problem.
 READABLE_KIND = _kind(("set_initial_state", "UNDEFINED_INITIAL_NUMERIC"))
+#: The features every arrange-up problem has, whichever way it was made (:func:`to_up` or
+#: ``PDDLReader`` with arrange-up's domain): typed objects, real fluents, numeric goals and the
+#: negative preconditions of place and push. A kind without one of them (a classical problem,
+#: or the bare ``ACTION_BASED`` kind unified-planning's meta engines ask about) is no
+#: arrange-up problem.
+ARRANGE_UP_CORE_KIND = m.ProblemKind(
+    {
+        "ACTION_BASED",
+        "SIMPLE_NUMERIC_PLANNING",
+        "FLAT_TYPING",
+        "HIERARCHICAL_TYPING",
+        "NEGATIVE_CONDITIONS",
+        "REAL_FLUENTS",
+    },
+    version=LATEST_PROBLEM_KIND_VERSION,
+)
 
 _KIND_TYPE = {
     ObjectKind.PART: "part",
@@ -329,6 +348,81 @@ def from_up(up_problem: Any) -> ArrangementProblem:
             )
         return effect.problem
     return problem_from_up(up_problem)
+
+
+def equip_pddl_problem(up_problem: Any, problem: ArrangementProblem) -> None:
+    """Give a problem read by ``PDDLReader`` from arrange-up's domain, **in place**, what PDDL
+    cannot express: the real parameters of ``place`` (``px``, ``py``, ``ptheta``) and ``push``
+    (also ``distance``) and their simulated effects (:func:`~arrange_up.up.effects.attach_effects`,
+    the deterministic semantics), as :func:`to_up` builds them. ``problem`` is
+    :func:`from_up` of it.
+
+    The engines call it before answering a plan for such a problem, so that the plan's actions
+    are the problem's own (unified-planning's ``SequentialPlanValidator`` and simulator accept
+    only those) and carry the poses and distances. Pose fluents without an initial value are
+    given one (an object on the table: its nominal pose, angle wrapped as :func:`to_up` does;
+    off it: 0, meaningless as in :func:`to_up`), since an effect reads and writes them. The
+    problem's kind gains ``REAL_ACTION_PARAMETERS`` and ``SIMULATED_EFFECTS``; afterwards
+    :func:`made_by_to_up` is true of it and :func:`from_up` maps it back through its effects
+    (an edit after that is refused, as for a compiled problem). Idempotent: a problem already
+    equipped (or made by :func:`to_up`) is left alone."""
+    if made_by_to_up(up_problem):
+        return
+    env = up_problem.environment
+    tm, em = env.type_manager, env.expression_manager
+    real = tm.RealType()
+    place, push = up_problem.action("place"), up_problem.action("push")
+    _add_parameters(
+        place,
+        env,
+        px=tm.RealType(0, exact(problem.table.width)),
+        py=tm.RealType(0, exact(problem.table.depth)),
+        ptheta=real,
+    )
+    _add_parameters(push, env, px=real, py=real, ptheta=real, distance=tm.RealType(0, None))
+    fluents = {key: up_problem.fluent(key) for key in ("x", "y", "theta")}
+    fluents["on_table"] = up_problem.fluent("on-table")
+    movable = tuple(s.name for s in problem.objects if s.kind is not ObjectKind.OBSTACLE)
+
+    def table(key: str) -> dict[str, Any]:
+        return {name: fluents[key](up_problem.object(name)) for name in movable}
+
+    rel: dict[str, tuple[Any, Any, Any]] = {}
+    if problem.goal.reference is not None:
+        reference = up_problem.object(problem.goal.reference)
+        rel = {
+            part: tuple(
+                up_problem.fluent(name)(up_problem.object(part), reference)
+                for name in ("rel-x", "rel-y", "rel-theta")
+            )
+            for part in problem.goal.parts
+        }
+    pose_fluents = PoseFluents(
+        fluents, movable, table("on_table"), table("x"), table("y"), table("theta"), rel
+    )
+    start = AngleFrame.of(problem).canonical(nominal_initial_state(problem))
+    known = up_problem.explicit_initial_values
+    for fluent, value in pose_fluents.values(problem, start).items():
+        if fluent not in known:
+            up_problem.set_initial_value(fluent, em.Real(value))
+    for name in movable:
+        for key in ("x", "y", "theta"):
+            fluent = getattr(pose_fluents, key)[name]
+            if fluent not in up_problem.explicit_initial_values:
+                up_problem.set_initial_value(fluent, em.Real(Fraction(0)))
+    effects = attach_effects(problem, "deterministic", place, push, pose_fluents)
+    fingerprint = _fingerprint(up_problem)
+    for effect in effects:
+        effect.fingerprint = fingerprint
+
+
+def _add_parameters(action: Any, environment: Any, **types: Any) -> None:
+    """Append real parameters to a unified-planning action. unified-planning 1.3 has no public
+    way to (its actions take their parameters when made); they live in the ordered mapping
+    ``_parameters``, which equality, grounding and printing read."""
+    for name, type_ in types.items():
+        if name not in action._parameters:
+            action._parameters[name] = m.Parameter(name, type_, environment)
 
 
 def _check_readable(up_problem: Any) -> None:

@@ -17,14 +17,18 @@ the engine is made: a bad value raises ``ValueError``, an unknown name ``TypeErr
 accepted ones. A ``solve`` ``timeout`` that is not a positive number of seconds raises
 ``ValueError`` too.
 
-**Kinds and guarantees.** ``supports(kind)`` is true for exactly the kind of the problems
-:func:`~arrange_up.up.compile.to_up` makes (:data:`SUPPORTED_KIND`), so selecting an engine by
-problem kind never picks arrange-up for a problem it would refuse. Problems read by
-``PDDLReader`` from arrange-up's domain have a generic numeric kind shared by many problems
-arrange-up cannot read: the engines answer them when chosen by name (unified-planning then
-warns that the kind alone does not tell). unified-planning's meta engines (``replanner``,
-``oversubscription``) therefore no longer wrap arrange-up: they hand the engine problems they
-edited, which :func:`~arrange_up.up.compile.from_up` refuses. The planner and the repairer are
+**Kinds and guarantees.** ``supported_kind()`` is the widest kind
+:func:`~arrange_up.up.compile.from_up` reads (:data:`SUPPORTED_KIND`): the kind of the problems
+:func:`~arrange_up.up.compile.to_up` makes and the kind of those ``PDDLReader`` reads from
+arrange-up's domain. ``supports(kind)`` is true for the kinds between it and the features every
+arrange-up problem has (:data:`~arrange_up.up.compile.ARRANGE_UP_CORE_KIND`), so
+``OneshotPlanner(problem_kind=problem.kind)`` finds arrange-up for both, and never for a
+classical problem. A foreign numeric problem of the same kind is answered
+``UNSUPPORTED_PROBLEM`` with the reason. unified-planning's meta engines (``replanner[...]``,
+``oversubscription[...]``) ask about the bare ``ACTION_BASED`` kind, so they do not wrap
+arrange-up; ``Replanner(problem, name="arrange-up")``, which makes the engine with a problem,
+is refused with a ``TypeError`` saying so: a replanner hands the engine edited problems, which
+cannot be mapped back to an arrangement. The planner and the repairer are
 satisficing (``satisfies(OptimalityGuarantee.SATISFICING)``), never optimal. Every engine has
 credits (``get_credits``), which unified-planning prints when it makes the engine
 (``get_environment().credits_stream = None`` silences them).
@@ -50,15 +54,17 @@ from unified_planning.plans import PlanKind
 
 from arrange_up.counts import check_count, is_number
 from arrange_up.parallel import BACKENDS
-from arrange_up.up.compile import TO_UP_KIND
+from arrange_up.up.compile import ARRANGE_UP_CORE_KIND, READABLE_KIND
 from arrange_up.up.registration import ENGINE_NAME, REPAIRER_NAME, VALIDATOR_NAME
 
-#: The problem kind every arrange-up engine supports: exactly the kind of what ``to_up`` makes.
-#: Problems read by ``PDDLReader`` from arrange-up's domain are of a generic numeric kind that
-#: many problems arrange-up cannot read share, so they are not offered by kind; the engines
-#: still answer them when chosen by name (unified-planning then warns that the kind alone does
-#: not tell).
-SUPPORTED_KIND = TO_UP_KIND
+#: The widest problem kind every arrange-up engine supports: what ``to_up`` makes and what
+#: ``PDDLReader`` makes of arrange-up's domain (``supports`` also asks for the core features).
+SUPPORTED_KIND = READABLE_KIND
+
+#: The keyword arguments unified-planning passes to an engine class made for an operation that
+#: takes the problem up front (``Replanner``, ``SequentialSimulator``), which no arrange-up
+#: engine implements.
+_PROBLEM_BOUND_ARGUMENTS = frozenset({"problem", "error_on_failed_checks"})
 
 #: Credits unified-planning prints when it makes one of the engines (``get_credits``).
 _CREDITS = {
@@ -112,7 +118,7 @@ class ArrangeUpEngine(Engine):
 
     @staticmethod
     def supports(problem_kind: ProblemKind) -> bool:
-        return bool(problem_kind <= SUPPORTED_KIND and SUPPORTED_KIND <= problem_kind)
+        return bool(ARRANGE_UP_CORE_KIND <= problem_kind and problem_kind <= SUPPORTED_KIND)
 
     @staticmethod
     def supports_plan(plan_kind: PlanKind) -> bool:
@@ -124,6 +130,13 @@ class ArrangeUpEngine(Engine):
         parameters (a bare ``__init__() got an unexpected keyword`` names none of them)."""
         if not unknown:
             return
+        if _PROBLEM_BOUND_ARGUMENTS <= set(unknown):
+            raise TypeError(
+                f"{cls._NAME} is not a replanner: unified-planning's Replanner and its meta "
+                "engines (replanner[...], oversubscription[...]) are not supported, since they "
+                "hand the engine problems they edited, which cannot be mapped back to an "
+                "arrange-up problem; use OneshotPlanner(name='arrange-up') on the whole problem"
+            )
         parts = []
         for name in sorted(unknown):
             close = difflib.get_close_matches(name, cls._PARAMETERS, n=1)

@@ -17,7 +17,13 @@ from unified_planning.plans import Plan
 
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action, Push
-from arrange_up.up.compile import from_up, made_by_to_up, plan_from_up, plan_to_up, to_up
+from arrange_up.up.compile import (
+    equip_pddl_problem,
+    from_up,
+    made_by_to_up,
+    plan_from_up,
+    plan_to_up,
+)
 
 
 @dataclass(frozen=True)
@@ -61,21 +67,22 @@ def read_problem_and_plan(
 def answer_plan(
     problem: AbstractProblem, arrangement: ArrangementProblem, actions: Sequence[Action]
 ) -> tuple[Plan, list[LogMessage]]:
-    """The unified-planning plan of ``actions`` for ``problem``, and the log messages to return
-    with it. A problem that did not come from :func:`arrange_up.up.compile.to_up` (one read from
-    PDDL) has no actions with real parameters, so the plan is one of ``to_up(arrangement)``."""
+    """The unified-planning plan of ``actions`` for ``problem``, over ``problem``'s own actions,
+    and the log messages to return with it. A problem read from PDDL, whose actions have no
+    real parameters, is first given them and their simulated effects, in place
+    (:func:`arrange_up.up.compile.equip_pddl_problem`), and a log message says so."""
     logs = []
-    target = problem
     if not made_by_to_up(problem):
-        target = to_up(arrangement, environment=problem.environment)
+        equip_pddl_problem(problem, arrangement)
         logs.append(
             LogMessage(
                 LogLevel.INFO,
-                "the problem came from PDDL, whose actions have no real parameters: the "
-                "plan's actions are those of arrange_up.up.compile.to_up(from_up(problem))",
+                "the problem came from PDDL, whose actions have no real parameters: its place "
+                "and push actions were given the poses and distances (and the simulated "
+                "effects) of arrange_up.up.compile.to_up's model, in place",
             )
         )
-    return plan_to_up(target, [plain_action(a) for a in actions]), logs
+    return plan_to_up(problem, [plain_action(a) for a in actions]), logs
 
 
 def plain_action(action: Action) -> Action:

@@ -17,8 +17,11 @@ arrange-up's PDDL domain), runs :func:`arrange_up.planning.planner.plan` and ret
 
 * ``SOLVED_SATISFICING``: a ``SequentialPlan`` of ``place``/``push``/``pick`` instances with
   exact ``Fraction`` real parameters (inches, degrees). For a problem read from PDDL, whose
-  actions cannot carry real parameters, the instances belong to ``to_up`` of the same problem
-  (a log message says so), with the names as ``PDDLReader`` read them (lowercase). The
+  actions cannot carry real parameters, the problem's ``place`` and ``push`` are first given
+  them and their simulated effects, in place
+  (:func:`~arrange_up.up.compile.equip_pddl_problem`; a log message says so), so the plan's
+  actions are the problem's own and unified-planning's ``SequentialPlanValidator`` accepts
+  them; the names are as ``PDDLReader`` read them (lowercase). The
   validator and the repairer read a plan's object names case-insensitively where the problem
   has no object of the exact name (PDDL names are case-insensitive), so such a plan is judged
   against ``to_up(load_pddl_problem(file))`` too; ``plan_from_up(plan, problem)`` names its
@@ -90,9 +93,14 @@ from arrange_up.up.engine_io import (
     metric_text,
     read_problem,
 )
+from arrange_up.up.plan_writer import install as install_plan_writer
 from arrange_up.up.registration import ENGINE_NAME
 
 __all__ = ["ArrangeUpPlanner"]
+
+# unified-planning's PDDLWriter (and so `up oneshot-planning --plan FILE`) writes the engine's
+# plans, whose actions have real parameters (arrange_up.up.plan_writer)
+install_plan_writer()
 
 
 class ArrangeUpPlanner(Satisficing, ArrangeUpEngine, OneshotPlannerMixin):

@@ -59,3 +59,43 @@ def test_an_interrupted_resumed_execute_says_how_many_were_read_back(tmp_path, m
         result.output
     )
     assert result.stderr.count("  episode ") == 1
+
+
+def _edited_line(record, edit) -> None:
+    lines = record.read_text().splitlines()
+    lines[1] = edit(lines[1])
+    record.write_text("\n".join(lines) + "\n")
+
+
+def test_a_record_line_with_infinity_or_an_action_past_the_episode_is_refused(tmp_path):
+    for name, edit, message in (
+        ("inf", lambda line: line.replace('"actions": 6', '"actions": Infinity', 1), "Infinity"),
+        (
+            "past",
+            lambda line: json.dumps(
+                {
+                    **json.loads(line),
+                    "success": False,
+                    "failure": {"kind": "action_failed", "action": 99999, "reason": "x"},
+                }
+            ),
+            "failure.action: expected the 0-based index of an action of the 6 executed",
+        ),
+        ("count", lambda line: line.replace('"actions": 6', '"actions": 99999', 1), "actions:"),
+    ):
+        record = tmp_path / f"{name}.jsonl"
+        _execute(record, 1)
+        assert '"actions": 6' in record.read_text()
+        _edited_line(record, edit)
+        args = ["execute", "blocks-2", "--episodes", "1", "--record", str(record), *CHEAP]
+        result = CliRunner().invoke(main, args)
+        assert result.exit_code == 2, (name, result.output)
+        assert result.exception is None or isinstance(result.exception, SystemExit)
+        assert f"{record}:2: not an episode record: " in result.stderr and message in result.stderr
+
+
+def test_a_record_that_is_not_a_regular_file_is_refused_before_any_work():
+    args = ["execute", "blocks-2", "--episodes", "1", "--record", "/dev/null", *CHEAP]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2, result.output
+    assert "/dev/null: not a regular file" in result.stderr

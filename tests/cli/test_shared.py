@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import sys
 
 import click
@@ -62,10 +63,36 @@ def test_load_problem_refuses_cleanly(tmp_path, capsys):
     assert "nothing was done" in capsys.readouterr().err
 
 
-def test_no_progress_display_off_a_terminal(monkeypatch):
-    monkeypatch.setattr(sys, "stderr", io.StringIO())
-    with shared.terminal_progress(TextColumn("x")) as display:
+def test_off_a_terminal_progress_is_a_line_every_interval_and_quiet_silences_it(monkeypatch):
+    import time
+
+    stream = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", stream)
+    monkeypatch.setattr(shared, "PROGRESS_INTERVAL", 0.05)
+    with shared.terminal_progress(TextColumn("x"), what="evaluate") as display:
+        assert isinstance(display, shared.LineProgress)
+        task = display.add_task("rollouts", total=200, summary="")
+        display.update(task, completed=50, summary="50 ok")
+        time.sleep(0.3)  # no further update: the line repeats anyway
+    lines = stream.getvalue().splitlines()
+    assert len(lines) >= 2
+    assert re.fullmatch(
+        r"arrange-up evaluate: rollouts 50/200 \(25%\), about \d+:\d\d:\d\d left, 50 ok "
+        r"\[0:00:00 elapsed\]",
+        lines[0],
+    ), lines[0]
+    count = len(lines)
+    time.sleep(0.2)
+    assert len(stream.getvalue().splitlines()) == count  # stopped with the block
+    with shared.terminal_progress(TextColumn("x"), quiet=True) as display:
         assert display is None
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    with shared.terminal_progress(TextColumn("x"), quiet=True) as display:
+        assert display is None
+
+
+def test_the_interval_is_under_the_ten_seconds_the_docs_promise():
+    assert 0 < shared.PROGRESS_INTERVAL <= 10
 
 
 def test_the_progress_display_on_a_terminal_is_gone_after_the_block(monkeypatch):
@@ -148,3 +175,28 @@ def test_plan_and_evaluate_show_their_progress_on_a_terminal(monkeypatch, capsys
     assert "blocks-1: solved" in printed and "of 2 rollouts reached the goal" in printed
     drawn = terminal.getvalue()
     assert "expanded" in drawn and "rollouts" in drawn and "ok (" in drawn
+
+
+def test_a_failed_output_write_is_one_line_exit_2(tmp_path, monkeypatch):
+    # a full disk or /dev/full (not written here: code that replaced the device node would
+    # destroy it on a machine running the tests as root)
+    import errno
+
+    import arrange_up.cli.problems as problems
+
+    def full(path, text):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(problems, "write_text_atomic", full)
+    result = CliRunner().invoke(main, ["export", "blocks-1", "-o", str(tmp_path / "b.pddl")])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (
+        f"arrange-up: {tmp_path / 'b.pddl'}: cannot write: No space left on device"
+    )
+
+
+def test_output_onto_a_symlink_writes_its_target_and_keeps_the_link(tmp_path):
+    link = tmp_path / "link.pddl"
+    link.symlink_to(tmp_path / "target.pddl")
+    assert CliRunner().invoke(main, ["export", "blocks-1", "-o", str(link)]).exit_code == 0
+    assert link.is_symlink() and (tmp_path / "target.pddl").read_text().startswith(";")

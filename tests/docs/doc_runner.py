@@ -51,10 +51,18 @@ NORMALISATIONS: tuple[tuple[re.Pattern[str], str], ...] = (
 )
 
 
+#: A progress line, printed every few seconds off a terminal (cli.shared.LineProgress): how
+#: many a command prints depends on the machine's speed, so the pages show none.
+PROGRESS_LINE = re.compile(r"^arrange-up [a-z -]+: .* \[\d+:\d\d:\d\d elapsed\]$")
+
+
 def normalise(text: str) -> list[str]:
-    """``text`` as lines without trailing blanks, with timings and worker counts replaced."""
+    """``text`` as lines without trailing blanks, with timings and worker counts replaced and
+    progress lines left out."""
     lines = []
     for line in text.splitlines():
+        if PROGRESS_LINE.match(line):
+            continue
         for pattern, replacement in NORMALISATIONS:
             line = pattern.sub(replacement, line)
         lines.append(line.rstrip())

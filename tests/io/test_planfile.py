@@ -336,3 +336,59 @@ def test_an_atomic_write_gives_the_file_the_umask_permissions(tmp_path):
         os.umask(previous)
     assert stat.S_IMODE(written.stat().st_mode) == 0o644
     assert [p.name for p in tmp_path.iterdir()] == ["plan.json"]  # no temporary file left
+
+
+def test_a_plan_file_naming_a_key_twice_is_refused_at_the_second_copy(tmp_path):
+    # json.loads keeps the last copy: a second "actions": [] ran the empty plan
+    problem = tiny("block-and-fixture")
+    text = json.dumps(document(problem), indent=2)
+    path = tmp_path / "twice.json"
+    path.write_text(text[: text.rindex("}")] + ',\n  "actions": []\n}\n')
+    line = path.read_text().count("\n") - 1
+    with pytest.raises(PlanFileError, match=rf'^{re.escape(str(path))}:{line}:3: key "actions"'):
+        read_plan(path, problem)
+
+
+def test_a_plan_file_nested_too_deeply_is_refused_with_line_and_column(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text('{"format":\n  ' + "[" * 100 + "]" * 100 + "}\n")
+    with pytest.raises(PlanFileError, match=rf"^{re.escape(str(path))}:2:34: nested too deeply"):
+        read_plan(path, tiny("block-and-fixture"))
+
+
+def test_an_atomic_write_writes_through_a_symlink_and_keeps_it(tmp_path):
+    target = tmp_path / "real.json"
+    target.write_text("old\n")
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    write_text_atomic(link, "new\n")
+    assert link.is_symlink() and target.read_text() == "new\n"
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+def test_an_atomic_write_writes_through_a_fifo_and_keeps_it(tmp_path):
+    import threading
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(fifo.read_text()))
+    reader.start()
+    write_text_atomic(fifo, "through\n")
+    reader.join(timeout=10)
+    assert received == ["through\n"]
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)  # not replaced by a regular file
+
+
+def test_a_plan_file_too_large_or_with_too_many_actions_is_refused(tmp_path):
+    from arrange_up.io.planfile import MAX_PLAN_ACTIONS
+
+    problem = tiny("block-and-fixture")
+    zero = Path("/dev/zero")
+    if zero.exists():  # endless: read up to the limit, then refused
+        with pytest.raises(PlanFileError, match=r"^/dev/zero: larger than 16 MiB"):
+            read_plan(zero, problem)
+    many = document(problem, (ACTIONS[2],) * (MAX_PLAN_ACTIONS + 1))
+    path = write(tmp_path, many)
+    with pytest.raises(PlanFileError, match=rf"actions: {MAX_PLAN_ACTIONS + 1} actions; a plan"):
+        read_plan(path, problem)

@@ -476,7 +476,7 @@ def test_cli_repair_writes_a_plan_file(tmp_path, down_push, down_nominal):
         catch_exceptions=False,
     )
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)  # progress lines go to stderr
     assert summary["status"] == "solved" and summary["semantics"] == "fixtures"
     assert summary["repair"]["steps"][0]["kind"] == "push"
     actions, _ = read_plan(out, down_push)

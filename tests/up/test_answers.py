@@ -5,6 +5,7 @@ timeouts are honoured, and unified-planning's ``up`` command can find the engine
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -220,11 +221,16 @@ def test_the_up_command_finds_the_engines_through_the_printed_configuration(tmp_
     (tmp_path / ".up.ini").write_text(printed.stdout, encoding="utf-8")
     command = [str(up_command), "oneshot-planning", "--engine", "arrange-up", "--pddl"]
     command += [str(domain_path()), str(domains_dir() / "blocks-1.pddl")]
+    command += ["--plan", str(tmp_path / "blocks-1.plan")]
     done = subprocess.run(
         command, capture_output=True, text=True, env=env, timeout=300, cwd=tmp_path
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "Status returned by arrange-up: SOLVED_SATISFICING" in done.stdout
+    # --plan: unified-planning's PDDL writer, taught real parameters (arrange_up.up.plan_writer)
+    written = (tmp_path / "blocks-1.plan").read_text(encoding="utf-8").splitlines()
+    assert written[0].startswith("(place a 9.088 0.912 ")
+    assert all(re.fullmatch(r"\((place|push|pick) [a-z]+( -?\d+(\.\d+)?)*\)", w) for w in written)
     listed = subprocess.run(
         [str(up_command), "list-engines"], capture_output=True, text=True, env=env, timeout=120
     )

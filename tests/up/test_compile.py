@@ -247,3 +247,36 @@ def test_plan_from_up_names_objects_as_the_problem_does():
         ),
     )
     assert [a.obj for a in plan_from_up(plan, both)] == ["A", "b"]
+
+
+def test_pddl_writer_writes_plans_with_real_parameters_and_others_unchanged():
+    from fractions import Fraction
+
+    from unified_planning.io import PDDLReader, PDDLWriter
+    from unified_planning.plans import ActionInstance, SequentialPlan
+
+    import arrange_up.up.planner_engine  # noqa: F401  (installs the writer's extension)
+    from arrange_up.io.domains import domains_dir
+    from arrange_up.io.pddl import domain_path
+    from arrange_up.up.plan_writer import decimal
+
+    assert [decimal(Fraction(v)) for v in ("8.066637", "-90", "0", "1/3")] == [
+        "8.066637",
+        "-90",
+        "0",
+        "0.333333333333",
+    ]
+    problem = to_up(load("blocks-1"))
+    plan = SequentialPlan(
+        [
+            ActionInstance(
+                problem.action("place"),
+                [problem.object("A"), Fraction("9.088"), Fraction("0.912"), Fraction(-15)],
+            ),
+            ActionInstance(problem.action("pick"), [problem.object("A")]),
+        ]
+    )
+    assert PDDLWriter(problem).get_plan(plan) == "(place a 9.088 0.912 -15)\n(pick a)\n"
+    read = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / "blocks-1.pddl"))
+    objects_only = SequentialPlan([ActionInstance(read.action("pick"), [read.object("a")])])
+    assert PDDLWriter(read).get_plan(objects_only) == "(pick a)\n"  # unified-planning's own

@@ -78,13 +78,13 @@ def test_the_engine_enforces_the_timeout():
 def test_a_problem_read_from_pddl_is_solved():
     path = domains_dir() / "blocks-1.pddl"
     up = PDDLReader().parse_problem(str(domain_path()), str(path))
-    # chosen by name: its generic numeric kind is not offered for selection, so UP warns
-    with pytest.warns(UserWarning, match="cannot establish whether arrange-up can solve"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # its kind is supported: unified-planning does not warn
         result = _solve(up)
     assert result.status is Status.SOLVED_SATISFICING
     assert "came from PDDL" in result.log_messages[0].message
     with PlanValidator(name="sequential_plan_validator") as validator:
-        check = validator.validate(to_up(from_up(up)), result.plan)
+        check = validator.validate(up, result.plan)
     assert check.status is ValidationResultStatus.VALID
 
 
@@ -97,8 +97,7 @@ def test_a_problem_read_with_another_domain_is_unsupported(tmp_path, old, new):
     domain = tmp_path / "other-domain.pddl"
     domain.write_text(domain_path().read_text().replace(old, new))
     up = PDDLReader().parse_problem(str(domain), str(domains_dir() / "blocks-1.pddl"))
-    with pytest.warns(UserWarning, match="cannot establish whether arrange-up can solve"):
-        result = _solve(up)
+    result = _solve(up)
     assert result.status is Status.UNSUPPORTED_PROBLEM and result.plan is None
     assert "was read with another domain than arrange-up's" in result.log_messages[0].message
 
@@ -207,16 +206,16 @@ def test_every_engine_gives_credits_and_unified_planning_prints_them(name):
 
 
 @pytest.mark.parametrize("name", sorted(ENGINE_CLASSES))
-def test_every_engine_supports_exactly_the_kind_of_to_up_problems(name):
+def test_every_engine_supports_the_kinds_of_to_up_and_pddl_read_problems_only(name):
     cls = ENGINE_CLASSES[name]
     for domain in ("blocks-1", "tz-mating", "create-a-t"):  # with and without relative goals
         assert cls.supports(to_up(load(domain)).kind)
-    assert cls.supported_kind() == to_up(load("blocks-1")).kind
-    # a plain classical problem, and what PDDLReader makes of arrange-up's domain: a generic
-    # numeric kind that many problems arrange-up cannot read share
+        pddl = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / f"{domain}.pddl"))
+        assert cls.supports(pddl.kind)
+        assert pddl.kind <= cls.supported_kind()
+    # a plain classical problem (and the bare kind unified-planning's meta engines ask about)
     assert not cls.supports(ProblemKind({"ACTION_BASED"}))
-    pddl = PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / "blocks-1.pddl"))
-    assert not cls.supports(pddl.kind)
+    assert not cls.supports(ProblemKind(set(cls.supported_kind().features) | {"CONTINUOUS_TIME"}))
 
 
 def test_selection_by_kind_never_picks_arrange_up_for_a_classical_problem():
@@ -346,8 +345,7 @@ def test_a_plan_solved_from_pddl_is_validated_against_the_file_as_arrange_up_loa
 
     path = domains_dir() / "blocks-2.pddl"
     up = PDDLReader().parse_problem(str(domain_path()), str(path))
-    with pytest.warns(UserWarning):
-        result = _solve(up)
+    result = _solve(up)
     assert {i.actual_parameters[0].object().name for i in result.plan.actions} <= {
         "a",
         "b",
@@ -358,7 +356,7 @@ def test_a_plan_solved_from_pddl_is_validated_against_the_file_as_arrange_up_loa
     for target in (up, to_up(held)):
         with PlanValidator(name="arrange-up-reliability", params=ROLLOUTS) as validator:
             with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # PDDL-read problems are not offered by kind
+                warnings.simplefilter("ignore")  # the reliability validator is chosen by name
                 check = validator.validate(target, result.plan)
         assert check.status is not ValidationResultStatus.UNKNOWN, check.log_messages
         verdicts.append((check.status, check.metrics["successes"], check.metrics["trials"]))
@@ -418,8 +416,47 @@ def test_a_problem_read_by_pddlreader_has_lowercase_names_and_the_same_nominal_p
     read = PDDLReader().parse_problem(str(domain_path()), str(path))
     assert {spec.name for spec in load("blocks-2").objects} >= {"A", "B"}
     assert {spec.name for spec in from_up(read).objects} >= {"a", "b", "paddle"}
-    with pytest.warns(UserWarning, match="cannot establish whether arrange-up can solve"):
-        from_pddl = _solve(read)
+    from_pddl = _solve(read)
     from_yaml = _solve(to_up(load("blocks-2")))
     assert from_pddl.status is from_yaml.status is Status.SOLVED_SATISFICING
     assert str(from_pddl.plan).lower() == str(from_yaml.plan).lower()
+
+
+def _pddl_read(name):
+    return PDDLReader().parse_problem(str(domain_path()), str(domains_dir() / f"{name}.pddl"))
+
+
+@pytest.mark.parametrize("name", ["blocks-2", "tz-mating"])  # absolute and relative goals
+def test_a_problem_read_by_up_from_pddl_finds_arrange_up_by_kind_and_validates(name):
+    problem = _pddl_read(name)
+    environment = get_environment()
+    saved, environment.credits_stream = environment.credits_stream, None
+    try:
+        with OneshotPlanner(problem_kind=problem.kind) as planner:
+            assert planner.name == "arrange-up"
+    finally:
+        environment.credits_stream = saved
+    result = _solve(problem, timeout=120)
+    assert result.status is Status.SOLVED_SATISFICING
+    # the plan's actions are the problem's own, so unified-planning's simulator accepts them
+    assert all(instance.action in problem.actions for instance in result.plan.actions)
+    assert any(len(i.actual_parameters) > 1 for i in result.plan.actions)  # poses carried
+    with PlanValidator(name="sequential_plan_validator") as validator:
+        check = validator.validate(problem, result.plan)
+    assert check.status is ValidationResultStatus.VALID, check
+    # equipped once: solving again maps it back through its effects, same plan
+    assert str(_solve(problem, timeout=120).plan) == str(result.plan)
+
+
+def test_replanner_is_refused_with_a_message_saying_so():
+    from unified_planning.shortcuts import Replanner
+
+    problem = to_up(load("blocks-1"))
+    environment = get_environment()
+    saved, environment.credits_stream = environment.credits_stream, None
+    try:
+        with pytest.raises(TypeError, match="not a replanner.*meta"):
+            Replanner(problem, name="arrange-up")
+    finally:
+        environment.credits_stream = saved
+    assert not any(name.endswith("[arrange-up]") for name in environment.factory.engines)
