@@ -162,7 +162,7 @@ def draw_storyboard(
 #: its axis labels.
 LEGEND_HEIGHT = 0.5
 TITLE_HEIGHT = 0.4
-LABEL_HEIGHT = 0.3
+LABEL_HEIGHT = 0.4
 
 
 def _draw_panel(ax, problem: ArrangementProblem, data, actions, k: int) -> None:
