@@ -138,19 +138,3 @@ def test_goal_regions_are_clipped_to_the_table() -> None:
             assert clip.y0 >= ty0 - 0.5 and clip.y1 <= ty1 + 0.5
     finally:
         pyplot().close(fig)
-
-
-def test_long_storyboard_rows_clear_each_other(long_storyboard: Any) -> None:
-    """No panel's axis labels run into the title of the panel below it."""
-    fig = long_storyboard
-    renderer = _renderer(fig)
-    panels = [ax for ax in fig.axes if ax.axison]
-    labels = [ax.xaxis.label.get_window_extent(renderer) for ax in panels]
-    titles = [ax.title.get_window_extent(renderer) for ax in panels]
-    clashes = [
-        (i, j)
-        for i, label in enumerate(labels)
-        for j, title in enumerate(titles)
-        if i != j and _overlap(label, title)
-    ]
-    assert clashes == []
