@@ -544,7 +544,8 @@ class _DaskSession(Session[T, R]):
         self.rescatter()
 
     def rescatter(self) -> None:
-        # every worker gets the context once (docs/design/planning.md, parallel planning)
+        # every worker gets the context once (docs/design/planning-performance.md, parallel
+        # planning)
         self.context_future = self.client.scatter(self.context, broadcast=True, hash=False)
 
     def send(self, item: T) -> Any:

@@ -47,6 +47,7 @@ from arrange_up.model.units import Units
 
 __all__ = [
     "PART_COLORS",
+    "clip_to_table",
     "compose",
     "draw_goal",
     "draw_heatmap",
@@ -349,12 +350,23 @@ def draw_goal(
     the way :func:`draw_problem` draws it in a panel of its own. Returns the artists added.
     """
     if problem.goal.is_relative:
-        return draw_relative_goal(
+        artists = draw_relative_goal(
             ax, problem, reference_pose=reference_pose or (0.0, 0.0, 0.0), tolerance=tolerance
         )
-    artists: list[Any] = []
+        return clip_to_table(ax, problem, artists) if reference_pose is not None else artists
+    artists = []
     for name, target in problem.goal.targets:
         artists += _draw_target(ax, problem, name, target, tolerance=tolerance)
+    return clip_to_table(ax, problem, artists)
+
+
+def clip_to_table(ax: Axes, problem: ArrangementProblem, artists: list[Any]) -> list[Any]:
+    """Clip ``artists`` to the table's surface, so a goal region that reaches past an edge
+    stops at the wall (no part can be there). Returns ``artists``."""
+    width, depth = problem.table.size
+    surface = Rectangle((0.0, 0.0), width, depth, transform=ax.transData)
+    for artist in artists:
+        artist.set_clip_path(surface)
     return artists
 
 
@@ -623,13 +635,16 @@ def problem_figure(problem: ArrangementProblem, *, title: str | None = None) -> 
         "any angle" if tol[2] is None else f"+-{units.angle_out(tol[2]):.3g} {units.angle}"
     )
     note = f"{note}\n{tol_text}" if note else tol_text
-    side.text(
-        1.03,
-        0.0,
+    # under the legend, whatever its height: a note anchored to the axes' foot would sit
+    # under a legend taller than the axes
+    side.annotate(
         note,
-        transform=side.transAxes,
+        xy=(0.0, 0.0),
+        xycoords=legend,
+        xytext=(0.0, -6.0),
+        textcoords="offset points",
         ha="left",
-        va="bottom",
+        va="top",
         fontsize=8,
         family="monospace",
         bbox={"boxstyle": "round", "facecolor": "white", "edgecolor": "#bbbbbb"},

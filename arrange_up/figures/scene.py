@@ -198,7 +198,7 @@ def draw_goal_outlines(
                  pose[1] - half[1]],
                 color=GOAL_COLOR, linewidth=0.8, zorder=3.5,
             )  # fmt: skip
-    return artists
+    return render.clip_to_table(ax, problem, artists)
 
 
 def draw_scene(ax: Axes, problem: ArrangementProblem, scene: Scene) -> None:
@@ -295,12 +295,12 @@ def draw_action(
 
 def describe(action: Action, problem: ArrangementProblem) -> str:
     """A short description of ``action`` in the problem's units: lengths with 2 decimals,
-    angles in whole degrees or in radians with 2 decimals."""
+    angles in whole degrees or in radians with 2 decimals, each angle with its unit."""
     units = problem.units
     if isinstance(action, Place):
         x, y, t = units.pose_out(action.pose)
         # rounded first: -0.02 deg reads "0", not "-0"
-        angle = f"{round(t)}" if units.angle == "deg" else f"{round(t, 2) + 0.0:.2f}"
+        angle = f"{round(t)} deg" if units.angle == "deg" else f"{round(t, 2) + 0.0:.2f} rad"
         return f"place {action.obj} at ({x:.2f}, {y:.2f}, {angle})"
     if isinstance(action, Push):
         return f"push {units.length_out(action.distance):.2f} {units.length}"

@@ -149,15 +149,20 @@ def draw_storyboard(
             fontsize=7,
             frameon=False,
         )
-        fig.tight_layout(rect=(0, LEGEND_HEIGHT / fig.get_figheight(), 1, 1))
+        # the panels between the legend's strip and the title's: tight_layout alone lets the
+        # first row's titles run up into the figure's title
+        height = fig.get_figheight()
+        fig.tight_layout(rect=(0, LEGEND_HEIGHT / height, 1, 1 - TITLE_HEIGHT / height))
         return save_figure(fig, output, dpi=dpi)
     finally:
         plt.close(fig)
 
 
-#: Inches below the panels for the legend, and below each row for its axis labels.
+#: Inches below the panels for the legend, above them for the title, and below each row for
+#: its axis labels.
 LEGEND_HEIGHT = 0.5
-LABEL_HEIGHT = 0.3
+TITLE_HEIGHT = 0.4
+LABEL_HEIGHT = 0.4
 
 
 def _draw_panel(ax, problem: ArrangementProblem, data, actions, k: int) -> None:

@@ -58,7 +58,8 @@ __all__ = [
 ]
 
 #: Searches after the first that validation may start. Measured on the fresh problems
-#: (docs/design/planning.md, "Validated plans"): the rounds that helped needed one or two.
+#: (docs/design/planning-validation.md, "Validated plans"): the rounds that helped needed one
+#: or two.
 VALIDATION_REPLANS = 3
 
 #: A search after the first may expand at most this many times the nodes the first expanded

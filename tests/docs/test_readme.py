@@ -112,3 +112,22 @@ def test_the_readme_problem_example_checks(tmp_path: Path, index: int) -> None:
         "arrange-up check example.yaml", tmp_path, TIMEOUT
     )
     assert result.returncode == 0, f"README.md:{block.line}: {result.stdout}"
+
+
+def test_room_table_lists_the_rooms_of_the_house_rule_in_order() -> None:
+    """The "How it works" table names every room, in the order (and rows) of ``ROOMS``, the
+    order tests/test_house.py enforces."""
+    import re
+    import sys
+
+    sys.path.insert(0, str(REPOSITORY / "benchmarks"))
+    from house import ROOMS
+
+    text = PAGE.read_text(encoding="utf-8")
+    section = text[text.index("## How it works") : text.index("## Documentation")]
+    rows = [
+        tuple(re.findall(r"`(\w+)`", line.split("|")[1]))
+        for line in section.splitlines()
+        if line.startswith("| `")
+    ]
+    assert [set(row) for row in rows] == [set(floor) for floor in ROOMS]

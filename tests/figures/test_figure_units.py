@@ -111,13 +111,13 @@ def test_an_inch_degree_problem_is_drawn_as_before():
 def test_place_titles_print_radians_with_two_decimals_and_degrees_whole(tmp_path):
     cm_rad = _problem(tmp_path, CM_RAD, "cm-rad")
     pose = cm_rad.units.pose_in((20.0, 10.0, 1.57))
-    assert describe(Place("A", pose), cm_rad) == "place A at (20.00, 10.00, 1.57)"
+    assert describe(Place("A", pose), cm_rad) == "place A at (20.00, 10.00, 1.57 rad)"
     inch_deg = load("blocks-4")
     place = Place("A", (4.0, 1.0, math.radians(90.4)))
-    assert describe(place, inch_deg) == "place A at (4.00, 1.00, 90)"
+    assert describe(place, inch_deg) == "place A at (4.00, 1.00, 90 deg)"
     # a small negative angle reads as zero, not "-0"
-    assert describe(Place("A", (4.0, 1.0, math.radians(-0.02))), inch_deg).endswith(", 0)")
-    assert describe(Place("A", pose[:2] + (-0.001,)), cm_rad).endswith(", 0.00)")
+    assert describe(Place("A", (4.0, 1.0, math.radians(-0.02))), inch_deg).endswith(", 0 deg)")
+    assert describe(Place("A", pose[:2] + (-0.001,)), cm_rad).endswith(", 0.00 rad)")
 
 
 def test_show_of_a_cm_rad_problem_writes_its_picture(tmp_path):

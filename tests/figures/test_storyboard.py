@@ -115,8 +115,8 @@ def test_draw_storyboard_of_a_fixture_plan_with_particles_closes_its_figure(tmp_
 
 def test_panel_titles_quote_the_problems_units():
     inch, mm = tiny("one-block"), tiny("millimetres")
-    assert describe(PLAN[0], inch) == "place A at (4.09, 0.91, 0)"
-    assert describe(PLAN[0], mm) == "place A at (103.84, 23.16, 0)"
+    assert describe(PLAN[0], inch) == "place A at (4.09, 0.91, 0 deg)"
+    assert describe(PLAN[0], mm) == "place A at (103.84, 23.16, 0 deg)"
     assert describe(PLAN[1], mm) == "push 13.90 mm"
     assert describe(Pick("A"), mm) == "pick A"
 

@@ -13,7 +13,7 @@ ahead. The first position keeps plans that move a neighbouring row along; the se
 contacts certain where CBST must refuse a clipped one (a row of blocks built against a wall,
 where each new block's push down clips the block beside it). Particle semantics simulate
 clipped contacts, and for them the extra pushes only widen the search, so it is off by default
-(the cases that motivate both positions are in docs/design/planning.md).
+(the cases that motivate both positions are in docs/design/planning-pushes.md).
 
 **Turning pushes** (:meth:`Approach.turning_centres`): a part whose belief is centred on an
 angle outside its goal's tolerance (modulo its symmetry period), and a relative goal's
@@ -45,8 +45,8 @@ from arrange_up.planning.generators.common import APPROACH_GAP, PushOptions
 
 #: Turning pushes (a part turned away from its goal angle): the manipulator's centre shifted
 #: across the push from the part's centre by this fraction of the manipulator's length, to
-#: either side, so that it presses one side of the part and turns it (docs/design/planning.md,
-#: "Turning pushes").
+#: either side, so that it presses one side of the part and turns it
+#: (docs/design/planning-pushes.md, "Turning pushes").
 TURN_OFFSET = 0.3
 
 
