@@ -311,9 +311,10 @@ def test_the_choice_skips_candidates_the_repair_rejects():
 def test_the_repair_keeps_the_plan_nominal_while_choosing():
     # With 3 particles the belief prefers, for a push of the tutorial's nominal plan, candidates
     # whose plan misses the goal nominally (the repair used to choose them and fail at the
-    # end); each is now rejected while choosing, and the repair solves.
+    # end); each is now rejected while choosing, and the repair solves. The nominal plan is the
+    # tutorial's: the whole goal searched at once (--no-agenda).
     problem = tiny("ell-and-box")
-    nominal = plan(problem, semantics="deterministic", seed=0).actions
+    nominal = plan(problem, semantics="deterministic", seed=0, agenda=False).actions
     assert _reaches_goal(problem, nominal)
     result = rp.repair_plan(problem, nominal, particles=3, seed=0)
     assert result.solved, result.reason
