@@ -24,6 +24,7 @@ __all__ = [
     "box_of",
     "box_row",
     "boxes_overlap",
+    "boxes_union",
     "swept_box",
     "wall_boxes",
 ]
@@ -68,6 +69,19 @@ def boxes_overlap(a: Box, b: Box, tol: float = 0.0) -> bool:
     b0, b1, b2, b3 = b
     return ((b2 if b2 < a2 else a2) - (b0 if b0 > a0 else a0) > tol) and (
         (b3 if b3 < a3 else a3) - (b1 if b1 > a1 else a1) > tol
+    )
+
+
+def boxes_union(boxes: Iterable[Box]) -> Box:
+    """The smallest box holding every box of ``boxes``; ``ValueError`` if there are none."""
+    boxes = list(boxes)
+    if not boxes:
+        raise ValueError("no boxes: no union")
+    return (
+        min(b[0] for b in boxes),
+        min(b[1] for b in boxes),
+        max(b[2] for b in boxes),
+        max(b[3] for b in boxes),
     )
 
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from arrange_up.belief.states import IntervalBelief, ParticleBelief
+from arrange_up.geometry.boxes import boxes_union
 from arrange_up.geometry.collision import CollisionChecker
 from arrange_up.geometry.se2 import rotate
 from arrange_up.model.problem import ArrangementProblem, Pose
@@ -355,13 +356,7 @@ def part_swaths(
         ):
             continue
         boxes = [checker.shadow_box(name, pose, _ZERO) for pose in before + final]
-        box = (
-            min(b[0] for b in boxes),
-            min(b[1] for b in boxes),
-            max(b[2] for b in boxes),
-            max(b[3] for b in boxes),
-        )
-        out.append((name, box))
+        out.append((name, boxes_union(boxes)))
     return tuple(out)
 
 
