@@ -225,6 +225,7 @@ PLAN_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     ),
     "huge-integer": (_pose(f"[{HUGE}, 0.5, 0]"), ("digits",)),
     "angle-1e300": (_pose("[9.5, 0.5, 1e300]"), ("angle",)),
+    "x-1e300": (_pose("[1e300, 0.5, 0]"), ("pose", "table sizes")),
     "nan-pose": (_pose("[NaN, 0.5, 0]"), ("pose",)),
     "infinite-distance": (
         _plan(
@@ -292,6 +293,13 @@ def test_a_bad_plan_file_is_refused_with_its_place(tmp_path, case):
     path = _write(tmp_path / f"{case}.json", content)
     result = _invoke(["evaluate", "blocks-1", str(path), "--rollouts", "1", "--workers", "1"])
     _assert_refused(result, str(path), "expected", *fragments)
+
+
+def test_show_refuses_a_plan_placing_a_part_at_1e300(tmp_path):
+    path = _write(tmp_path / "far.json", PLAN_CASES["x-1e300"][0])
+    result = _invoke(["show", "blocks-1", "--plan", str(path), "-o", str(tmp_path / "s.png")])
+    _assert_refused(result, str(path), "actions[0].pose", "table sizes")
+    assert not (tmp_path / "s.png").exists()
 
 
 def test_the_valid_files_the_cases_start_from_are_accepted(tmp_path):
