@@ -9,10 +9,10 @@ finished measurements printed above it), and at the end the result table on stdo
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import click
 from rich.progress import (
@@ -71,6 +71,9 @@ from arrange_up.model.problem import ControllerKind
 from arrange_up.parallel import BackendUnavailableError, RunnerConfig
 from arrange_up.repair import METHODS
 from arrange_up.transitions import available
+
+#: What a pending-measurements function returns.
+_Pending = TypeVar("_Pending")
 
 #: The semantics whose planners --particles makes; --semantics names the others.
 _PARTICLE_PLANNERS = ("deterministic", "particles")
@@ -215,6 +218,16 @@ def _problem_names(problems: str) -> list[str]:
     return names
 
 
+def _resumed(pending: Callable[[], _Pending]) -> _Pending:
+    """What ``pending`` lists as still to measure, read from a CSV that may be resumed; a CSV
+    that cannot be (other columns, bytes that are not UTF-8, ...) ends the command by the
+    error contract (one line, exit 2)."""
+    try:
+        return pending()
+    except CsvRecordsError as error:
+        fail(str(error))
+
+
 def _interrupted(csv: Path) -> None:
     """Exit 1 after Ctrl-C, saying where the rows measured so far are."""
     fail(f"interrupted; the rows measured so far are in {csv}: run again to resume", EXIT_NEGATIVE)
@@ -324,7 +337,7 @@ def experiment_transition_comparison(
         check_semantics(name)
         planners.append(Planner(name, name, 1))
     names = _problem_names(problems)
-    pending = pending_transition_runs(Path(output_dir), names, planners, runs)
+    pending = _resumed(lambda: pending_transition_runs(Path(output_dir), names, planners, runs))
     estimate = costs.Estimate()
     for name, label, _run in pending:
         planning = costs.planning_cost(name, label, max_nodes)
@@ -429,7 +442,7 @@ def experiment_search_table(
         semantics = "cbst" if "cbst" in available() else "deterministic"
     check_semantics(semantics)
     names = _problem_names(problems)
-    pending = pending_searches(Path(output_dir), names, semantics)
+    pending = _resumed(lambda: pending_searches(Path(output_dir), names, semantics))
     estimate = costs.Estimate()
     for k, domination, name in pending:
         cost = costs.search_cost(semantics, name, k, domination, max_nodes)
@@ -581,14 +594,16 @@ def experiment_fixtures(
     if not counts or any(n < 1 for n in counts):
         fail(f"--particles: expected positive integers, got {particle_counts!r}")
     names = _problem_names(problems)
-    pending = pending_rows(
-        Path(output_dir),
-        problems=names,
-        plans=plans,
-        particles=counts,
-        seed=seed,
-        method=method,
-        ablation=ablation,
+    pending = _resumed(
+        lambda: pending_rows(
+            Path(output_dir),
+            problems=names,
+            plans=plans,
+            particles=counts,
+            seed=seed,
+            method=method,
+            ablation=ablation,
+        )
     )
     estimate = costs.Estimate()
     for name, count, stage in pending:

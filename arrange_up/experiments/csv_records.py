@@ -12,7 +12,10 @@ appender's ``done``). The CSV gets the care of the evaluation's record files
   change a measurement without being a key column (node limits, rollouts, timeouts, ...) are
   kept beside the CSV in ``NAME.settings.json`` and compared on every rerun (a CSV written
   before settings were kept has none to compare; its first rerun records them);
-* a key is measured once: writing a row whose key is already in the file raises.
+* a key is measured once: writing a row whose key is already in the file raises;
+* a file that is not UTF-8, or a cell of a number column (the appender's ``numbers``) that is
+  not a finite number of its kind, is refused with its ``file:line`` before anything is
+  measured: a word, ``nan`` or ``-inf`` there would otherwise be resumed into the results.
 
 Values read back are strings, as :class:`csv.DictReader` gives them.
 """
@@ -32,6 +35,7 @@ from arrange_up.io.files import lock_exclusively
 __all__ = [
     "CsvAppender",
     "CsvRecordsError",
+    "Numbers",
     "Progress",
     "done_keys",
     "mean",
@@ -39,19 +43,61 @@ __all__ = [
     "settings_path",
 ]
 
+#: The kind of each number column of a CSV: ``int`` or ``float`` (finite); an empty cell is
+#: a value not measured and passes.
+Numbers = Mapping[str, type[int] | type[float]]
 #: Receives one line of progress text at a time.
 Progress = Callable[[str], None]
 
 
 class CsvRecordsError(ValueError):
     """An experiment CSV that is in use by another run, has other columns, was made with other
-    settings, or would get a key measured twice."""
+    settings, holds a cell that is not UTF-8 or not a number where one belongs, or would get a
+    key measured twice."""
 
 
 def read_csv(path: Path) -> list[dict[str, str]]:
-    """Every row of the CSV at ``path``, keyed by its header (a cut-off last line left out)."""
-    text = Path(path).read_bytes().decode("utf-8")
-    return list(csv.DictReader(io.StringIO(_whole_lines(text), newline="")))
+    """Every row of the CSV at ``path``, keyed by its header (a cut-off last line left out).
+
+    Raises :class:`CsvRecordsError` with ``file:line`` for bytes that are not UTF-8."""
+    text = _whole_text(Path(path), Path(path).read_bytes())
+    return list(csv.DictReader(io.StringIO(text, newline="")))
+
+
+def _whole_text(path: Path, data: bytes) -> str:
+    """The whole lines of ``data`` (a kill may cut the last one, even inside a character),
+    decoded; :class:`CsvRecordsError` with ``path:line`` for bytes that are not UTF-8."""
+    if data and not data.endswith(b"\n"):
+        data = data[: data.rfind(b"\n") + 1]
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data[: error.start].count(b"\n") + 1
+        raise CsvRecordsError(
+            f"{path}:{line}: byte 0x{data[error.start]:02x} is not UTF-8 text; the CSV was "
+            "changed by something other than the experiment: repair that line or write to "
+            "another output directory"
+        ) from None
+
+
+def _check_numbers(path: Path, line: int, row: Mapping[str, str], numbers: Numbers) -> None:
+    """Refuse (with ``path:line``) a cell of a number column that is not a finite number of
+    its kind."""
+    for column, kind in numbers.items():
+        cell = row.get(column) or ""
+        if not cell:
+            continue
+        try:
+            value = kind(cell)
+        except ValueError:
+            value = None
+        if value is None or not math.isfinite(value):
+            what = "an integer" if kind is int else "a finite number"
+            raise CsvRecordsError(
+                f"{path}:{line}: column {column} holds {cell[:40]!r}, not {what}; the CSV was "
+                "changed by something other than the experiment: repair that line or write "
+                "to another output directory"
+            )
 
 
 def done_keys(path: Path, fields: Sequence[str]) -> set[tuple[str, ...]]:
@@ -81,7 +127,8 @@ class CsvAppender:
     locks the file, drops a cut-off last line, refuses other columns or settings, and gives
     ``write.done`` (the keys already measured, as tuples of strings); ``write(row)`` appends a
     row and flushes it, and raises :class:`CsvRecordsError` for a key already measured. The
-    header is written when the file is new or empty.
+    header is written when the file is new or empty. ``numbers`` names the number columns
+    whose cells the rows already there must hold (see :data:`Numbers`).
     """
 
     def __init__(
@@ -91,8 +138,10 @@ class CsvAppender:
         *,
         key: Sequence[str] = (),
         settings: Mapping[str, Any] | None = None,
+        numbers: Numbers | None = None,
     ) -> None:
         self.path = Path(path)
+        self.numbers = dict(numbers or {})
         self.fields = list(fields)
         self.key = tuple(key)
         self.settings = dict(settings or {})
@@ -131,6 +180,7 @@ class CsvAppender:
                 f"{self.path}: its columns ({found}) are not this experiment's "
                 f"({', '.join(self.fields)}); write to another output directory"
             )
+        self._check_cells(_whole_text(self.path, data))
         if whole != text:  # a run killed while writing a row: drop the cut-off line
             self.handle.truncate(len(whole.encode("utf-8")))
         self._check_settings(has_rows=len(rows) > 1)
@@ -141,6 +191,11 @@ class CsvAppender:
         index = {name: k for k, name in enumerate(self.fields)}
         for row in rows[1:]:
             self.done.add(tuple(row[index[f]] if index[f] < len(row) else "" for f in self.key))
+
+    def _check_cells(self, text: str) -> None:
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        for row in reader:
+            _check_numbers(self.path, reader.line_num, row, self.numbers)
 
     def _check_settings(self, *, has_rows: bool) -> None:
         where = settings_path(self.path)

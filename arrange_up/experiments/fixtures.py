@@ -63,7 +63,14 @@ from matplotlib.patches import Patch
 
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.evaluation.records import plan_hash
-from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
+from arrange_up.experiments.csv_records import (
+    CsvAppender,
+    Numbers,
+    Progress,
+    done_keys,
+    mean,
+    read_csv,
+)
 from arrange_up.experiments.problems import controller_setting, driven_problems, physics_setting
 from arrange_up.figures.backend import pyplot
 from arrange_up.model.world import Push
@@ -141,6 +148,13 @@ FIXTURE_FIELDS = [
 #: each: how the failed rollouts failed.
 FAILURE_KINDS = ("goal_missed", "action_failed", "not_at_rest", "off_table")
 _KEY = ("problem", "seed", "plan", "stage", "particles", "method")
+#: The number columns of ``fixtures.csv``, checked when a run resumes it.
+FIXTURE_NUMBERS: Numbers = {
+    **dict.fromkeys(("seed", "plan", "particles", "nominal_length", "plan_length"), int),
+    **dict.fromkeys(("pushes", "fixtures_placed", "simulations", "rollouts", "successes"), int),
+    **dict.fromkeys(FAILURE_KINDS, int),
+    **dict.fromkeys(("seconds", "reliability", "interval_low", "interval_high"), float),
+}
 
 
 class StaleResultsError(RuntimeError):
@@ -229,7 +243,9 @@ def fixture_experiment(
         "controller": controller_setting(loaded),
         "physics": physics_setting(loaded),
     }
-    with CsvAppender(path, FIXTURE_FIELDS, key=_KEY, settings=settings) as append:
+    with CsvAppender(
+        path, FIXTURE_FIELDS, key=_KEY, settings=settings, numbers=FIXTURE_NUMBERS
+    ) as append:
         existing = read_csv(path)  # under the lock: what an earlier run measured
         done = append.done  # grows as rows are written: a repeated problem or count is done too
 

@@ -32,7 +32,14 @@ from typing import Any
 from matplotlib.patches import Patch
 
 from arrange_up.evaluation.evaluate import evaluate_plan
-from arrange_up.experiments.csv_records import CsvAppender, Progress, done_keys, mean, read_csv
+from arrange_up.experiments.csv_records import (
+    CsvAppender,
+    Numbers,
+    Progress,
+    done_keys,
+    mean,
+    read_csv,
+)
 from arrange_up.experiments.problems import controller_setting, driven_problems, physics_setting
 from arrange_up.figures.backend import pyplot
 from arrange_up.parallel import RunnerConfig, available_cores
@@ -72,6 +79,15 @@ SEARCH_FIELDS = [
     "cost",
     "seconds",
 ]
+#: The number columns of each CSV, checked when a run resumes it.
+TRANSITION_NUMBERS: Numbers = {
+    **dict.fromkeys(
+        ("particles", "run", "seed", "solved", "expanded", "transitions_simulated"), int
+    ),
+    **dict.fromkeys(("plan_length", "rollouts", "successes"), int),
+    **dict.fromkeys(("planning_seconds", "reliability", "interval_low", "interval_high"), float),
+}
+SEARCH_NUMBERS: Numbers = {"solved": int, "expanded": int, "cost": int, "seconds": float}
 SEARCH_TYPES = (("BFS", "blind"), ("Admiss.", "admissible"), ("Inadmiss.", "inadmissible"))
 #: Receives each CSV row as soon as it is written.
 Measured = Callable[[dict[str, Any]], None]
@@ -133,7 +149,9 @@ def transition_comparison(
         "controller": controller_setting(loaded),
         "physics": physics_setting(loaded),
     }
-    with CsvAppender(path, TRANSITION_FIELDS, key=_TRANSITION_KEY, settings=settings) as write:
+    with CsvAppender(
+        path, TRANSITION_FIELDS, key=_TRANSITION_KEY, settings=settings, numbers=TRANSITION_NUMBERS
+    ) as write:
         done = write.done  # grows as rows are written: a repeated planner is measured once
         for name in problems:
             problem = loaded[name]
@@ -254,7 +272,9 @@ def search_table(
         "controller": controller_setting(loaded),
         "physics": physics_setting(loaded),
     }
-    with CsvAppender(path, SEARCH_FIELDS, key=_SEARCH_KEY, settings=settings) as write:
+    with CsvAppender(
+        path, SEARCH_FIELDS, key=_SEARCH_KEY, settings=settings, numbers=SEARCH_NUMBERS
+    ) as write:
         done = write.done  # grows as rows are written: a repeated problem is measured once
         for label, heuristic in SEARCH_TYPES:
             for domination in (False, True):

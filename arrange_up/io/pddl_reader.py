@@ -146,6 +146,25 @@ def _check_text(text: str, source: str, domain: str | Path | None) -> Checked:
                 )
             ]
         )
+    supported = _Text(domain_text).requirements()
+    unsupported = located.unsupported_requirement(supported)
+    if unsupported is not None:
+        token, index = unsupported
+        line, column = located.position(index)
+        raise ProblemFormatError(
+            [
+                Diagnostic(
+                    source,
+                    line,
+                    column,
+                    ":requirements",
+                    f"the problem requires {token}, which arrange-up does not support; "
+                    "expected none or those its domain declares "
+                    f"({' '.join(sorted(supported))}): its actions "
+                    "are instantaneous, with unconditional effects",
+                )
+            ]
+        )
     try:
         up_problem = PDDLReader().parse_problem_string(domain_text, text)
     except Exception as error:  # UP raises many kinds; each becomes one diagnostic
@@ -232,6 +251,25 @@ class _Text:
         pattern = rf"(?<![\w-]){re.escape(name)}(?![\w-])"
         found = list(re.finditer(pattern, section.group(0), flags=re.IGNORECASE))[:2]
         return self.position(section.start() + found[-1].start()) if found else (None, None)
+
+    def requirements(self) -> set[str]:
+        """The requirement flags the ``:requirements`` section declares, lowercased."""
+        return {token.lower() for token, _index in self._requirement_tokens()}
+
+    def unsupported_requirement(self, supported: set[str]) -> tuple[str, int] | None:
+        """The first requirement flag declared that is not in ``supported``, as written, with
+        its index in the text; None when every one is."""
+        for token, index in self._requirement_tokens():
+            if token.lower() not in supported:
+                return token, index
+        return None
+
+    def _requirement_tokens(self) -> list[tuple[str, int]]:
+        section = re.search(r"\(\s*:requirements\b([^()]*)\)", self.code, flags=re.IGNORECASE)
+        if section is None:
+            return []
+        start = section.start(1)
+        return [(m.group(0), start + m.start()) for m in re.finditer(r"\S+", section.group(1))]
 
     def domain_name(self) -> str | None:
         match = re.search(r"\(\s*:domain\s+([^\s()]+)", self.code, flags=re.IGNORECASE)

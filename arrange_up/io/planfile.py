@@ -113,6 +113,14 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
         ):
             raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {_shown(pose)}")
         internal = units.pose_in(as_triple(pose))
+        reach = MAX_POSE_REACH * max(problem.table.size)
+        for axis, value, size in zip("xy", internal[:2], problem.table.size, strict=True):
+            if not -reach <= value <= size + reach:
+                raise PlanFileError(
+                    f"{where}.pose: {axis} = {_shown(pose['xy'.index(axis)])} {units.length} is "
+                    f"more than {MAX_POSE_REACH} table sizes from the table; expected a pose "
+                    "on or near it (docs/plan-format.md)"
+                )
         reason = angle_problem(internal[2], units.angle)
         if reason is not None:
             raise PlanFileError(f"{where}.pose[2]: angle {pose[2]:g} {units.angle}: {reason}")
@@ -236,6 +244,11 @@ MAX_DEPTH = 32
 #: ``/dev/zero``) from taking the memory and time of every command that reads plans.
 MAX_PLAN_BYTES = 16 * 2**20
 MAX_PLAN_ACTIONS = 10_000
+#: How far from the table an action's pose may be, in table sizes (the larger of its width
+#: and depth). Pushes start just off an edge and places stay on it; a pose thousands of
+#: tables away means nothing, and far enough out (1e300) a part's outline collapses to no
+#: area in double precision.
+MAX_POSE_REACH = 100
 
 
 def _read_document(path: Path) -> Any:

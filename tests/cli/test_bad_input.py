@@ -135,6 +135,17 @@ def _pddl(old: str, new: str) -> str:
 
 
 PDDL_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
+    "durative-and-conditional": (
+        _pddl(
+            "(:domain arrange-up)",
+            "(:domain arrange-up)\n  (:requirements :durative-actions :conditional-effects)",
+        ),
+        (":16:18:", ":durative-actions", "does not support"),
+    ),
+    "conditional-effects": (
+        _pddl("(:domain arrange-up)", "(:domain arrange-up) (:requirements :strips\n :ADL)"),
+        (":16:2:", ":ADL"),
+    ),
     "big-integer-table": (_pddl("(table-width) 10)", f"(table-width) {BIG})"), ("digits",)),
     "big-integer-goal": (_pddl("(<= (x A) 9.7)", f"(<= (x A) {BIG})"), ("digits",)),
     "big-integer-noise": (_pddl("(= (place-dx) 0.2)", f"(= (place-dx) {BIG})"), ("digits",)),
@@ -225,6 +236,7 @@ PLAN_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     ),
     "huge-integer": (_pose(f"[{HUGE}, 0.5, 0]"), ("digits",)),
     "angle-1e300": (_pose("[9.5, 0.5, 1e300]"), ("angle",)),
+    "x-1e300": (_pose("[1e300, 0.5, 0]"), ("pose", "table sizes")),
     "nan-pose": (_pose("[NaN, 0.5, 0]"), ("pose",)),
     "infinite-distance": (
         _plan(
@@ -292,6 +304,21 @@ def test_a_bad_plan_file_is_refused_with_its_place(tmp_path, case):
     path = _write(tmp_path / f"{case}.json", content)
     result = _invoke(["evaluate", "blocks-1", str(path), "--rollouts", "1", "--workers", "1"])
     _assert_refused(result, str(path), "expected", *fragments)
+
+
+def test_show_refuses_a_plan_placing_a_part_at_1e300(tmp_path):
+    path = _write(tmp_path / "far.json", PLAN_CASES["x-1e300"][0])
+    result = _invoke(["show", "blocks-1", "--plan", str(path), "-o", str(tmp_path / "s.png")])
+    _assert_refused(result, str(path), "actions[0].pose", "table sizes")
+    assert not (tmp_path / "s.png").exists()
+
+
+def test_a_pddl_problem_may_declare_its_domains_requirements(tmp_path):
+    declared = "(:requirements :strips :TYPING :negative-preconditions :numeric-fluents)"
+    text = _pddl("(:domain arrange-up)", f"(:domain arrange-up)\n  {declared}")
+    path = _write(tmp_path / "declared.pddl", text)
+    result = _invoke(["check", str(path)])
+    assert result.exit_code == 0, result.output
 
 
 def test_the_valid_files_the_cases_start_from_are_accepted(tmp_path):

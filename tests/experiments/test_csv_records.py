@@ -164,3 +164,58 @@ def test_a_rerun_with_a_cut_off_line_resumes_and_other_settings_exit_2(tmp_path:
     assert "other settings" in result.output and "rollouts" in result.output
     # refused before any work: no estimate of work that will not be done
     assert "estimate:" not in result.output
+
+
+def test_a_number_column_holding_a_word_nan_or_inf_is_refused_with_its_line(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    numbers = {"run": int, "value": float}
+    with CsvAppender(path, FIELDS, key=KEY, settings=SETTINGS, numbers=numbers) as write:
+        write({"problem": "p", "run": 0, "value": 1.5})
+        write({"problem": "p", "run": 1, "value": ""})  # not measured: passes
+    good = path.read_bytes()
+    for cell in ("many", "nan", "-inf", "Infinity", "1.5x"):
+        path.write_bytes(good.replace(b"1.5", cell.encode()))
+        with pytest.raises(CsvRecordsError, match=rf"t\.csv:2: column value holds '{cell}'"):
+            with CsvAppender(path, FIELDS, key=KEY, settings=SETTINGS, numbers=numbers):
+                pass
+    path.write_bytes(good.replace(b"p,1,", b"p,1.0,"))
+    with pytest.raises(CsvRecordsError, match=r"t\.csv:3: column run holds '1.0', not an integer"):
+        with CsvAppender(path, FIELDS, key=KEY, settings=SETTINGS, numbers=numbers):
+            pass
+
+
+def test_bytes_that_are_not_utf8_are_refused_with_their_line(tmp_path: Path):
+    path = tmp_path / "t.csv"
+    with _appender(path) as write:
+        write({"problem": "p", "run": 0, "value": 1})
+        write({"problem": "q", "run": 0, "value": 1})
+    path.write_bytes(path.read_bytes().replace(b"q,", b"\xffq,"))
+    for reading in (
+        lambda: read_csv(path),
+        lambda: done_keys(path, KEY),
+        _appender(path).__enter__,
+    ):
+        with pytest.raises(CsvRecordsError, match=r"t\.csv:3: byte 0xff is not UTF-8"):
+            reading()
+    # a kill may cut the last line inside a character: that line is dropped, not refused
+    path.write_bytes(path.read_bytes().replace(b"\xffq,", b"q,") + "p,1,\u00e9".encode()[:-1])
+    assert len(read_csv(path)) == 2
+
+
+@pytest.mark.parametrize("cell", ["many", "nan", "-inf"])
+def test_experiment_refuses_a_resumed_csv_with_a_bad_number_cell_exit_2(tmp_path: Path, cell: str):
+    args = ["experiment", "search-table", "--problems", "blocks-1", "--semantics"]
+    args += ["deterministic", "--output-dir", str(tmp_path), "--quiet"]
+    assert CliRunner().invoke(main, args).exit_code == 0
+    path = tmp_path / "search-table.csv"
+    lines = path.read_bytes().split(b"\r\n")
+    lines[3] = lines[3].rsplit(b",", 1)[0] + b"," + cell.encode()
+    path.write_bytes(b"\r\n".join(lines[:4]) + b"\r\n")
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2, result.output
+    assert f"search-table.csv:4: column seconds holds '{cell}'" in result.output
+    assert "Traceback" not in result.output
+    path.write_bytes(b"\r\n".join(lines[:3]) + b"\r\n\xff\r\n")
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2, result.output
+    assert "search-table.csv:4: byte 0xff is not UTF-8" in result.output

@@ -128,6 +128,14 @@ BAD_ACTIONS = [
         "x.distance: expected a non-negative number",
     ),
     ({"type": "push", "manipulator": "paddle", "pose": [1, 1, 0]}, "x.distance: .* got None"),
+    (
+        {"type": "place", "object": "A", "pose": [1e300, 1, 0]},
+        r"x.pose: x = 1e\+300 in is more than 100 table sizes from the table",
+    ),
+    (
+        {"type": "push", "manipulator": "paddle", "pose": [1, -1e9, 0], "distance": 1},
+        r"x.pose: y = -1000000000.0 in is more than 100 table sizes",
+    ),
 ]
 
 
@@ -392,3 +400,14 @@ def test_a_plan_file_too_large_or_with_too_many_actions_is_refused(tmp_path):
     path = write(tmp_path, many)
     with pytest.raises(PlanFileError, match=rf"actions: {MAX_PLAN_ACTIONS + 1} actions; a plan"):
         read_plan(path, problem)
+
+
+def test_a_pose_off_the_table_but_within_reach_is_read():
+    problem = tiny("block-and-fixture")
+    width, depth = problem.table.size
+    far = 99 * max(width, depth)
+    for pose in ([-far, 1, 0], [1, depth + far, 0]):
+        action = action_from_json(
+            {"type": "place", "object": "A", "pose": pose}, problem.units, problem, "x"
+        )
+        assert action == Place("A", (pose[0], pose[1], 0.0))
