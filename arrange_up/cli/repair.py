@@ -88,7 +88,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     type=click.IntRange(1, 100_000),
     default=DEFAULT_PARTICLES,
     show_default=True,
-    help="Particles of the belief the candidates are scored on.",
+    help="Particles of the belief the candidates are simulated and scored on.",
 )
 @seed_option("Seed for the particles, the noise and the nominal plan: equal seeds, equal plans.")
 @click.option(
@@ -138,12 +138,16 @@ def repair(
     """Make a nominal plan for PROBLEM robust by placing fixtures (thesis ch. 4).
 
     Every push of the nominal plan becomes place(fixture), push, pick(fixture) (or stays a
-    bare push, with its distance multiplied by 1 to 2) choosing what keeps the particle belief
-    closest to the nominal trajectory; place and pick actions stay. See docs/repair.md.
+    bare push, with its distance multiplied by 1 to 2). The candidates (grid placements, see
+    --method; placements that stop a part where its end is uncertain; bare pushes) are
+    ranked by reliability: the share of rollouts of the plan's remaining actions, run from the
+    candidate's simulated particles with the same noise for every candidate, that reach the
+    goal. The mean distance to the nominal plan's next state breaks ties, and a fixture is
+    kept only if it beats the best bare push. Place and pick actions stay. See docs/repair.md.
 
     \b
     Examples:
-      arrange-up repair tz-mating --particles 150 --output tz.fixtures.json
+      arrange-up repair tz-mating --particles 10 --output tz.fixtures.json
       arrange-up repair tz-mating --plan tz.nominal.json --method naive --json
       arrange-up repair tz-mating --plan tz.nominal.json --no-fixtures -o tz.ablation.json
 
