@@ -19,10 +19,10 @@ from __future__ import annotations
 import argparse
 import itertools
 import time
-from pathlib import Path
 
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.io.domains import load
+from arrange_up.parallel import RunnerConfig
 from arrange_up.planning.planner import plan
 
 PROBLEMS = ("blocks-2", "blocks-3", "blocks-4", "blocks-7", "blocks-9", "blocks-9-square")
@@ -41,7 +41,7 @@ def main() -> None:
     )
     args = parser.parse_args()
     models = args.models.split(",") if args.models else [None]
-    print("problem          model        status     nodes  CPU s  fallbacks         reliability")
+    print("problem          status     nodes  CPU s  fallbacks         reliability  model")
     for name, model in itertools.product(args.problems.split(","), models):
         problem = load(name)
         started = time.process_time()
@@ -52,13 +52,17 @@ def main() -> None:
         reliability = "-"
         if result.actions is not None:
             score = evaluate_plan(
-                problem, result.actions, rollouts=args.rollouts, seed=0, workers=1
+                problem,
+                result.actions,
+                rollouts=args.rollouts,
+                seed=0,
+                runner=RunnerConfig(workers=1),
             )
             reliability = f"{score.successes}/{score.trials}"
         print(
-            f"{name:<16} {Path(model or 'shipped').stem:<12} {result.status:<10} "
+            f"{name:<16} {result.status:<10} "
             f"{result.stats['expanded']:>5} {seconds:>6.1f}  "
-            f"{share:<17} {reliability}",
+            f"{share:<17} {reliability:<12} {model or 'shipped'}",
             flush=True,
         )
 
