@@ -3,22 +3,26 @@
 Usage::
 
     python benchmarks/cbst_fallback.py [--problems blocks-2,blocks-3,...] [--rollouts 1000]
+        [--models compliant,path/to/other.json]
 
 Plans each shipped problem under its own (compliant) controller with ``semantics="cbst"``
-(the shipped model, seed 0, one worker, the goal agenda, no validation) and prints one row per
-problem: status, nodes expanded, the search's CPU seconds (``time.process_time`` of this
-process, where CBST and its fallback run), the push transitions that fell back to the physics
-of all asked for, and the plan's reliability on ``--rollouts`` rollouts (seed 0, one worker,
-in this process). Written for issue 33's targets: see docs/cbst.md, "The simulated fallback".
+(the shipped model, or each of ``--models`` in turn; seed 0, one worker, the goal agenda, no
+validation) and prints one row per problem and model: status, nodes expanded, the search's
+CPU seconds (``time.process_time`` of this process, where CBST and its fallback run), the
+push transitions that fell back to the physics of all asked for, and the plan's reliability
+on ``--rollouts`` rollouts (seed 0, one worker, in this process). Written for issue 33's
+targets: see docs/cbst.md, "The simulated fallback".
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import time
 
 from arrange_up.evaluation.evaluate import evaluate_plan
 from arrange_up.io.domains import load
+from arrange_up.parallel import RunnerConfig
 from arrange_up.planning.planner import plan
 
 PROBLEMS = ("blocks-2", "blocks-3", "blocks-4", "blocks-7", "blocks-9", "blocks-9-square")
@@ -30,24 +34,35 @@ def main() -> None:
     parser.add_argument(
         "--rollouts", type=int, default=1000, help="rollouts per plan (default: %(default)s)"
     )
+    parser.add_argument(
+        "--models",
+        default="",
+        help="comma-separated CBST models (shipped names or .json cards); default the shipped",
+    )
     args = parser.parse_args()
-    print("problem          status     nodes  CPU s  fallbacks         reliability")
-    for name in args.problems.split(","):
+    models = args.models.split(",") if args.models else [None]
+    print("problem          status     nodes  CPU s  fallbacks         reliability  model")
+    for name, model in itertools.product(args.problems.split(","), models):
         problem = load(name)
         started = time.process_time()
-        result = plan(problem, semantics="cbst", workers=1, validate=0)
+        result = plan(problem, semantics="cbst", model=model, workers=1, validate=0)
         seconds = time.process_time() - started
         fell, pushes = result.fallbacks or (0, 0)
         share = f"{fell}/{pushes} ({fell / pushes:.0%})" if pushes else "-"
         reliability = "-"
         if result.actions is not None:
             score = evaluate_plan(
-                problem, result.actions, rollouts=args.rollouts, seed=0, workers=1
+                problem,
+                result.actions,
+                rollouts=args.rollouts,
+                seed=0,
+                runner=RunnerConfig(workers=1),
             )
             reliability = f"{score.successes}/{score.trials}"
         print(
-            f"{name:<16} {result.status:<10} {result.stats['expanded']:>5} {seconds:>6.1f}  "
-            f"{share:<17} {reliability}",
+            f"{name:<16} {result.status:<10} "
+            f"{result.stats['expanded']:>5} {seconds:>6.1f}  "
+            f"{share:<17} {reliability:<12} {model or 'shipped'}",
             flush=True,
         )
 

@@ -40,9 +40,13 @@ How an example is drawn (``GenerationSettings`` holds every number):
   :func:`arrange_up.physics.simulation.simulate`.
 * Targets over the rollouts that came to rest (the others are counted; an example with fewer
   than 90 % of its rollouts at rest is kept in the file but not trained on): ``dx``, ``dy``,
-  ``dθ`` as defined in :mod:`.features`. The largest overshoot of ``x_max`` is recorded too,
-  to check the structural assumption that the train ends flush against the wall; its
-  positive part is the fourth target, ``slip``.
+  ``dθ`` and ``slip`` as defined in :mod:`.features`, each the settings' ``quantile`` of the
+  rollouts (1.0: their largest). The largest overshoot of ``x_max`` is recorded too, to
+  check the structural assumption that the train ends flush against the wall.
+* With ``outcomes=True`` (the fresh test sets of :func:`arrange_up.cbst.model.train_cbst`)
+  a record also keeps, per block, every rollout's four deviations (``x_max - u``,
+  ``|v - v_c|``, ``|θ|`` in degrees, ``u - x_max``), from which a model's *coverage* is
+  measured: the share of rollouts ending inside its predicted box.
 
 Reproducibility: example ``i`` is a function of ``(seed, i, K, settings)`` only (its generator
 is seeded with ``[seed, i]``), so the data set is the same for any worker count or order.
@@ -151,12 +155,20 @@ class GenerationSettings:
     """Where the push sends the paddle's front (module docstring): ``"uniform"`` between just
     beyond the compressed train and the wall, ``"wall"`` at the wall, or ``"planner"`` where
     CBST's push to the wall does."""
+    quantile: float = 1.0
+    """The quantile of the rollouts each target is (:mod:`.features`): 1.0, the largest (the
+    thesis's maxima), or a high quantile such as 0.99, so that a target does not widen with
+    the number of rollouts per example."""
 
     def __post_init__(self) -> None:
         if self.wall_push not in WALL_PUSHES:
             raise ValueError(
                 f"GenerationSettings.wall_push must be one of {', '.join(WALL_PUSHES)}, "
                 f"got {self.wall_push!r}"
+            )
+        if not 0.5 <= self.quantile <= 1.0:
+            raise ValueError(
+                f"GenerationSettings.quantile must lie in [0.5, 1], got {self.quantile!r}"
             )
 
     def as_dict(self) -> dict[str, Any]:
@@ -179,12 +191,15 @@ class GenerationSettings:
     def digest(self) -> str:
         """A short hash of every setting. The controller is left out when it is the default
         servo, and ``wall_push`` when it is ``"uniform"``, so that data files (and model
-        cards) written before they were settings keep their digest."""
+        cards) written before they were settings keep their digest; so is ``quantile`` when it
+        is 1.0 (the maxima)."""
         values = self.as_dict()
         if self.controller == SERVO:
             del values["controller"]
         if self.wall_push == "uniform":
             del values["wall_push"]
+        if self.quantile == 1.0:
+            del values["quantile"]
         text = json.dumps(values, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -263,6 +278,11 @@ def _draw_config(rng: np.random.Generator, n: int, s: GenerationSettings) -> _Co
             m = (d - s.min_overlap) - (halves[-1][1] + h[1])
             if m >= 0.0:
                 break
+        else:
+            # The previous block's dy leaves (almost) no room for a certain contact (a domain
+            # wider than d - MIN_OVERLAP): the widest dy that still has one, centred.
+            h = (h[0], max(0.0, (d - s.min_overlap) - halves[-1][1]), h[2])
+            m = 0.0
         halves.append(h)
         if j > 0:
             vs.append(vs[-1] + float(rng.uniform(-m, m)))
@@ -341,10 +361,14 @@ def generate_example(
     seed: int,
     rollouts: int,
     settings: GenerationSettings = DEFAULT_GENERATION,
+    outcomes: bool = False,
 ) -> dict[str, Any]:
     """Example ``index`` of the data set of ``seed`` (module docstring), as a JSON-ready dict:
     ``features`` and ``targets`` (one row per block, paddle side first), ``overshoot`` per
-    block, rollout counts and whether the example is ``valid`` (enough rollouts at rest)."""
+    block, rollout counts and whether the example is ``valid`` (enough rollouts at rest);
+    with ``outcomes``, also every rollout's deviations per block (``outcomes``, rollouts x 4
+    per block, in target order). ``outcomes`` draws no random numbers: the example is the
+    same either way."""
     if rollouts < 1:
         raise ValueError("rollouts must be at least 1")
     started = time.perf_counter()
@@ -398,8 +422,9 @@ def generate_example(
         "failed": failed,
         "valid": ok >= max(1, math.ceil(s.min_ok_fraction * rollouts)),
     }
-    rows, targets, overshoot = [], [], []
+    rows, targets, overshoot, deviations = [], [], [], []
     arr = np.array(finals, dtype=float).reshape(ok, n, 3)
+    q = s.quantile
     paddle_half = cfg.paddle_half
     for j in range(n):
         if j == 0:
@@ -416,18 +441,26 @@ def generate_example(
         if ok:
             x_max = cfg.wall - (n - j - 0.5) * s.block_size
             u, v, th = arr[:, j, 0], arr[:, j, 1], arr[:, j, 2]
-            targets.append(
-                [
-                    float(x_max - u.min()),
-                    float(np.abs(v - cfg.centers[j][1]).max()),
-                    math.degrees(float(np.abs(_wrap(th, 0.5 * math.pi)).max())),
-                    max(0.0, float(u.max() - x_max)),
-                ]
+            each = np.column_stack(
+                (
+                    x_max - u,
+                    np.abs(v - cfg.centers[j][1]),
+                    np.degrees(np.abs(_wrap(th, 0.5 * math.pi))),
+                    u - x_max,
+                )
             )
+            # np.quantile at 1.0 is the largest exactly, so maxima-trained data is unchanged.
+            target = np.quantile(each, q, axis=0)
+            target[3] = max(0.0, target[3])
+            targets.append([float(t) for t in target])
             overshoot.append(float(u.max() - x_max))
+            if outcomes:
+                deviations.append(np.round(each, 5).tolist())
     record["features"] = rows
     record["targets"] = targets
     record["overshoot"] = overshoot
+    if outcomes:
+        record["outcomes"] = deviations
     record["seconds"] = round(time.perf_counter() - started, 4)
     return record
 
@@ -480,10 +513,12 @@ def generate_dataset(
     scheduler: str | None = None,
     chunksize: int | None = None,
     settings: GenerationSettings = DEFAULT_GENERATION,
+    outcomes: bool = False,
     progress: TrainingProgress | None = None,
 ) -> dict[str, Any]:
     """Make sure ``path`` holds examples ``0 .. examples-1`` of the data set of ``seed`` with
-    ``rollouts`` rollouts each, computing and appending the missing ones.
+    ``rollouts`` rollouts each, computing and appending the missing ones (with every
+    rollout's deviations when ``outcomes``: :func:`generate_example`).
 
     ``backend``, ``workers`` (``None``: every core) and ``scheduler`` choose the runner
     (:func:`arrange_up.parallel.get_runner`: ``"local"`` processes or a ``"dask"`` cluster);
@@ -507,7 +542,9 @@ def generate_dataset(
     if pending:
         runner = get_runner(backend, workers, scheduler)
         size = chunksize or auto_chunksize(len(pending), runner.workers, most=8)
-        task = partial(generate_example, seed=seed, rollouts=rollouts, settings=settings)
+        task = partial(
+            generate_example, seed=seed, rollouts=rollouts, settings=settings, outcomes=outcomes
+        )
         with path.open("a", encoding="utf-8") as fh:
             for _index, record in runner.map(task, pending, size):
                 fh.write(json.dumps(record, separators=(",", ":")) + "\n")
@@ -527,7 +564,9 @@ def generate_dataset(
 @dataclass(frozen=True)
 class Dataset:
     """Rows of a data file: features ``X`` (rows x 12), targets ``y`` (rows x 4), the example
-    index of each row (``groups``), and per-file statistics."""
+    index of each row (``groups``), and per-file statistics. ``outcomes``: per row, its
+    rollouts' deviations (rollouts x 4, :func:`generate_example`), when every valid record
+    of the file kept them; else None."""
 
     X: np.ndarray
     y: np.ndarray
@@ -538,6 +577,7 @@ class Dataset:
     rollouts: int
     failed_rollouts: int
     example_seconds: float
+    outcomes: list[np.ndarray] | None = None
 
 
 def load_dataset(
@@ -571,6 +611,7 @@ def load_dataset(
 
 def _arrays(records: Iterable[dict[str, Any]], rollouts: int) -> Dataset:
     X, y, groups, over = [], [], [], []
+    outcomes: list[np.ndarray] | None = []
     n = invalid = failed = 0
     seconds = 0.0
     for record in records:
@@ -584,6 +625,10 @@ def _arrays(records: Iterable[dict[str, Any]], rollouts: int) -> Dataset:
         y.extend(record["targets"])
         over.extend(record["overshoot"])
         groups.extend([record["index"]] * len(record["targets"]))
+        if outcomes is not None and "outcomes" in record:
+            outcomes.extend(np.asarray(o, dtype=float).reshape(-1, 4) for o in record["outcomes"])
+        else:
+            outcomes = None
     return Dataset(
         X=np.asarray(X, dtype=float).reshape(-1, 12),
         y=np.asarray(y, dtype=float).reshape(-1, 4),
@@ -594,4 +639,5 @@ def _arrays(records: Iterable[dict[str, Any]], rollouts: int) -> Dataset:
         rollouts=rollouts,
         failed_rollouts=failed,
         example_seconds=seconds,
+        outcomes=outcomes,
     )

@@ -47,6 +47,10 @@ Targets (4 numbers): three are the thesis's definitions over K rollouts ``i``:
   widens the interval's upper end to ``x_max + max(slip, allowance)``, the allowance being
   the contact slop of the physics measured in the data (model card).
 
+With ``GenerationSettings.quantile`` ``q`` below 1 (:mod:`.data`), every maximum over the
+rollouts above is their ``q`` quantile instead (``dx``: of ``x_max - u_i``), so that a target
+does not widen as the rollouts per example grow.
+
 Validity domain: the model answers only for inputs inside the ranges it was trained on
 (:class:`Domain`); outside them the semantics declines to predict.
 """

@@ -228,12 +228,46 @@ def _row_depths(X: np.ndarray, groups: np.ndarray) -> np.ndarray:
     return depths
 
 
-def _test_scores(model: CBSTRegressor, test: Dataset, seed: int, path: Path) -> dict[str, Any]:
-    """The scores of ``model`` on the fresh test set ``test`` (generated with ``seed``)."""
-    scores = _scores(test.y, model.predict(test.X))
+def _coverage(
+    predicted: np.ndarray,
+    outcomes: list[np.ndarray],
+    depths: np.ndarray,
+    allowance: Mapping[str, float],
+) -> dict[str, float]:
+    """Per target, the share of all rollouts of the rows whose deviation lies inside the box
+    the semantics builds from ``predicted`` (clipped at 0, as it does): ``x_max - u <= dx``,
+    ``|v - v_c| <= dy``, ``|θ| <= dth``, and for ``slip`` the box's upper end,
+    ``u - x_max <= max(slip, allowance of the row's depth)``; ``box``: all four at once."""
+    inside: dict[str, list[np.ndarray]] = {name: [] for name in (*TARGET_NAMES, "box")}
+    for row, each, depth in zip(np.maximum(predicted, 0.0), outcomes, depths, strict=True):
+        limits = row.copy()
+        limits[3] = max(row[3], float(allowance.get(str(int(depth)), 0.0)))
+        within = each <= limits
+        for k, name in enumerate(TARGET_NAMES):
+            inside[name].append(within[:, k])
+        inside["box"].append(within.all(axis=1))
+    return {
+        name: float(np.concatenate(flags).mean()) if flags else math.nan
+        for name, flags in inside.items()
+    }
+
+
+def _test_scores(
+    model: CBSTRegressor, test: Dataset, seed: int, path: Path, allowance: Mapping[str, float]
+) -> dict[str, Any]:
+    """The scores of ``model`` on the fresh test set ``test`` (generated with ``seed``): RMSE
+    and R^2 per target, and, when the test set kept its rollouts' outcomes, the coverage of
+    the predicted boxes (:func:`_coverage`, with the card's overshoot ``allowance``)."""
+    predicted = model.predict(test.X)
+    scores = _scores(test.y, predicted)
+    coverage = {}
+    if test.outcomes is not None:
+        depths = _row_depths(test.X, test.groups)
+        coverage["test_coverage"] = _coverage(predicted, test.outcomes, depths, allowance)
     return {
         "test_rmse": scores["rmse"],
         "test_r2": scores["r2"],
+        **coverage,
         "test": {
             "examples": test.examples,
             "invalid_examples": test.invalid,
@@ -250,7 +284,9 @@ def _score_card(cv_scores: Mapping[str, Any], test_scores: Mapping[str, Any]) ->
         "method": (
             f"cv_*: {cv_scores['cv_folds']}-fold GroupKFold (by example) over the training "
             "data, out-of-fold predictions of the card's hyperparameters; test_*: the model "
-            "on a fresh test set generated with another seed (scores.test)"
+            "on a fresh test set generated with another seed (scores.test); test_coverage: "
+            "the share of that set's rollouts ending inside the predicted box, per target "
+            "and for the whole box"
         ),
         "cv_folds": cv_scores["cv_folds"],
         "cv_rmse": cv_scores["cv_rmse"],
@@ -361,6 +397,7 @@ def train_cbst(
         rollouts=rollouts_per_example,
         seed=test_seed,
         settings=settings,
+        outcomes=True,
         progress=None if progress is None else partial(_relabel, progress, "test data"),
         **parallel,
     )
@@ -388,6 +425,7 @@ def train_cbst(
     if progress is not None:
         progress("fit", 1, 1)
     depths = _row_depths(dataset.X, dataset.groups)
+    allowance = _overshoot_allowance(dataset.overshoot, depths)
     import sklearn  # here: importing scikit-learn is slow, and only training needs it
 
     card: dict[str, Any] = {
@@ -426,7 +464,7 @@ def train_cbst(
         "block_size": settings.block_size,
         "paddle_size": list(settings.paddle_size),
         "domain": settings.domain.as_dict(),
-        "overshoot_allowance": _overshoot_allowance(dataset.overshoot, depths),
+        "overshoot_allowance": allowance,
         "buckled_rows": int(np.sum(dataset.overshoot > BUCKLE_LIMIT)),
         "buckle_limit": BUCKLE_LIMIT,
         "model": {
@@ -436,7 +474,7 @@ def train_cbst(
             "selection": "GridSearchCV, scoring mean R^2, GroupKFold by example",
             **report,
         },
-        "scores": _score_card(report, _test_scores(model, test, test_seed, test_data)),
+        "scores": _score_card(report, _test_scores(model, test, test_seed, test_data, allowance)),
         "training_seconds": round(time.monotonic() - started, 1),
     }
     save_model(model, card, out, name)
@@ -492,6 +530,7 @@ def rescore_model(
             rollouts=rollouts,
             seed=s,
             settings=settings,
+            outcomes=path is test_data_path,
             progress=None if progress is None else partial(_relabel, progress, stage),
             **parallel,
         )
@@ -515,7 +554,9 @@ def rescore_model(
         progress("fit", 1, 1)
     scores = _score_card(
         {"cv_folds": folds, "cv_rmse": cv_scores["rmse"], "cv_r2": cv_scores["r2"]},
-        _test_scores(model, test, test_seed, Path(test_data_path)),
+        _test_scores(
+            model, test, test_seed, Path(test_data_path), card.get("overshoot_allowance", {})
+        ),
     )
     scores["cv_data"] = {
         "examples": dataset.examples,

@@ -69,6 +69,12 @@ def _echo_scores(scores: dict) -> None:
             f"{scores['test_rmse'][target]:.4f} {unit} (R2 {scores['test_r2'][target]:.3f})"
             + (f"; thesis test RMSE {thesis}" if thesis is not None else "")
         )
+    coverage = scores.get("test_coverage")
+    if coverage is not None:
+        click.echo(
+            "fresh test coverage (rollouts inside the predicted box): "
+            + ", ".join(f"{name} {share:.2%}" for name, share in coverage.items())
+        )
 
 
 @click.command("train-cbst")
@@ -103,6 +109,21 @@ def _echo_scores(scores: dict) -> None:
     "compliant: past the compressed train by its worst-case stall; docs/cbst.md). "
     "[default: the shipped model's of the controller: planner for compliant, uniform for "
     "servo]",
+)
+@click.option(
+    "--quantile",
+    type=click.FloatRange(0.5, 1.0),
+    default=DEFAULT_GENERATION.quantile,
+    show_default=True,
+    help="The quantile of each example's rollouts its targets are (1: their largest, the "
+    "thesis's; e.g. 0.99 for boxes that do not widen with the rollouts).",
+)
+@click.option(
+    "--block-half",
+    type=(click.FloatRange(min=0.0, min_open=True),) * 3,
+    default=DEFAULT_GENERATION.domain.block_half,
+    show_default=True,
+    help="The training domain: the largest half-widths of a block's belief (in, in, deg).",
 )
 @click.option(
     "--test-examples",
@@ -154,6 +175,8 @@ def train_cbst(
     rollouts_per_example: int,
     controller: str,
     wall_push: str | None,
+    quantile: float,
+    block_half: tuple[float, float, float],
     test_examples: int,
     test_seed: int,
     seed: int,
@@ -188,7 +211,10 @@ def train_cbst(
                 output_dir=output_dir,
                 controller=Controller(kind=ControllerKind(controller)),
                 settings=replace(
-                    DEFAULT_GENERATION, wall_push=wall_push or SHIPPED_WALL_PUSH[controller]
+                    DEFAULT_GENERATION,
+                    wall_push=wall_push or SHIPPED_WALL_PUSH[controller],
+                    quantile=quantile,
+                    domain=replace(DEFAULT_GENERATION.domain, block_half=block_half),
                 ),
                 test_examples=test_examples,
                 test_seed=test_seed,

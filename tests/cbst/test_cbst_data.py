@@ -50,6 +50,40 @@ def test_example_layout_and_targets():
     assert np.all(y[:, 0] > -0.05)  # dx: x_max is the flush position, up to contact slop
 
 
+def test_quantile_targets_lie_within_the_rollouts_and_outcomes_give_them_back():
+    """Targets as a quantile of the rollouts: 1.0 is the maxima (the default, whose settings
+    digest is unchanged), a lower quantile never exceeds them, and the recorded outcomes are
+    the rollouts the targets were taken over."""
+    rollouts = 40
+    at_max = generate_example(2, seed=3, rollouts=rollouts, outcomes=True)
+    q90 = replace(DEFAULT_GENERATION, quantile=0.9)
+    at_q90 = generate_example(2, seed=3, rollouts=rollouts, settings=q90, outcomes=True)
+    assert at_max["features"] == at_q90["features"] and at_max["outcomes"] == at_q90["outcomes"]
+    assert q90.digest() != DEFAULT_GENERATION.digest()
+    for j, each in enumerate(at_max["outcomes"]):
+        each = np.asarray(each)
+        assert each.shape == (at_max["ok"], 4)
+        top, q = np.asarray(at_max["targets"][j]), np.asarray(at_q90["targets"][j])
+        assert np.allclose(top[:3], each.max(axis=0)[:3], atol=1e-5)
+        assert np.all(q <= top + 1e-12)
+        assert np.allclose(q[:3], np.quantile(each, 0.9, axis=0)[:3], atol=1e-5)
+    assert "outcomes" not in generate_example(2, seed=3, rollouts=rollouts)
+    with pytest.raises(ValueError, match="quantile"):
+        replace(DEFAULT_GENERATION, quantile=1.5)
+
+
+def test_a_domain_wider_than_a_certain_contact_allows_still_draws_examples():
+    """Half-widths across the push up to 0.6 in: two neighbours may leave no room for a
+    certain contact; the example is still drawn, with the contact certain."""
+    wide = replace(DEFAULT_GENERATION, domain=Domain(block_half=(0.6, 0.6, 30.0)))
+    for index in range(40):
+        record = generate_example(index, seed=0, rollouts=1, settings=wide)
+        X = np.asarray(record["features"])
+        assert wide.domain.contains(X).all()
+        between = X[1:]
+        assert np.all(np.abs(between[:, 9]) + between[:, 1] + between[:, 4] <= 0.6 + 1e-9)
+
+
 def test_example_depends_only_on_seed_and_index():
     a = generate_example(5, seed=2, rollouts=ROLLOUTS)
     b = generate_example(5, seed=2, rollouts=ROLLOUTS)

@@ -220,5 +220,25 @@ def test_train_cbst_end_to_end_in_one_process(tmp_path):
     assert card["scores"]["test"]["examples"] == 4 and card["scores"]["test"]["seed"] == 1
     assert (tmp_path / "compliant.data.jsonl").exists()
     assert (tmp_path / "compliant.test.jsonl").exists()
+    coverage = card["scores"]["test_coverage"]
+    assert set(coverage) == {"dx", "dy", "dth", "slip", "box"}
+    assert all(0.0 <= share <= 1.0 for share in coverage.values())
+    assert coverage["box"] <= min(coverage[name] for name in ("dx", "dy", "dth", "slip"))
     model = load_model(tmp_path / "compliant.json")
     assert model.predict(np.zeros((1, 12))).shape == (1, 4)
+
+
+def test_coverage_counts_rollouts_inside_the_predicted_box():
+    from arrange_up.cbst.model import _coverage
+
+    predicted = np.array([[0.1, 0.2, 5.0, -0.3], [0.0, 0.1, 1.0, 0.05]])
+    outcomes = [
+        # inside; dx beyond; slip beyond the depth-1 allowance 0.01 (slip predicted < 0)
+        np.array([[0.05, 0.1, 4.0, 0.0], [0.2, 0.1, 4.0, 0.0], [0.0, 0.0, 0.0, 0.02]]),
+        # inside (slip 0.05 predicted); dth beyond
+        np.array([[0.0, 0.1, 1.0, 0.05], [0.0, 0.0, 2.0, 0.0]]),
+    ]
+    coverage = _coverage(predicted, outcomes, np.array([1, 2]), {"1": 0.01, "2": 0.0})
+    assert coverage["dx"] == pytest.approx(4 / 5) and coverage["dy"] == 1.0
+    assert coverage["dth"] == pytest.approx(4 / 5) and coverage["slip"] == pytest.approx(4 / 5)
+    assert coverage["box"] == pytest.approx(2 / 5)
