@@ -61,8 +61,8 @@ def _status_line(stats: dict[str, Any]) -> str:
 def _check_model(problem: ArrangementProblem, model: str | None) -> None:
     """Exit 2 when the cbst model (``None``: the shipped one for the problem's controller) is
     unknown, unsound or trained under another controller than the problem's."""
-    # Lazy: only the cbst semantics needs scikit-learn (its import, with the model room, took
-    # 0.13 s measured, see arrange_up.up.planner_engine); the planner imports it next anyway.
+    # Lazy: only the cbst semantics needs scikit-learn, whose import is slow (see
+    # arrange_up.up.planner_engine); the planner imports it next anyway.
     from arrange_up.cbst.choice import model_for
 
     try:

@@ -85,10 +85,10 @@ semi-implicit Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))``
 
 i.e. the thesis's clipped PD with ``Kd = sqrt(4 m Kp)`` when ``damping_ratio = 1`` (the
 default), written in the usual cascade form so that the speed limit caps the desired velocity.
-At dt = 1/240 and the paddle's m ~ 0.15 this is Kd ~ 36, Kp ~ 2,200 (omega = 1 / (2 dt) =
-120 rad/s): a stiff position servo, as a robot arm is. With these gains the velocity loop is
-dead-beat in discrete time and the position error then shrinks by ``1 - rate dt = 3/4`` per
-step: no overshoot, no oscillation.
+The gains grow as ``1 / dt`` and ``1 / dt**2``: a stiff position servo, as a robot arm is (their
+values at the default step: ``docs/design/physics.md``, "The push controller"). With these gains
+the velocity loop is dead-beat in discrete time and the position error then shrinks by
+``1 - rate dt = 3/4`` per step: no overshoot, no oscillation.
 
 *Where it differs from a fixed-gain PD:* in contact, the joint is solved together with the
 contacts, so its derivative gain is the dead-beat one for everything the paddle is moving (the
@@ -97,15 +97,13 @@ speed while pushing and stalls only when the push needs more than ``push_force``
 wall), whereas a PD with the paddle's own gains would stall once ``Kp * error`` falls below the
 resistance. The thesis's observation that a push stops short when it collides holds in both.
 
-Defaults: ``push_speed = 3 in/s`` (a careful robot push; the paddle travels 0.0125 in per step,
-far below the 0.25 in tunnelling limit of 1-inch blocks) and ``push_force = 400`` (in the units
-above; a 1-inch block of density 0.125 weighs 48, so this pushes a chain of 7 blocks at the
-highest friction and density of the thesis's ranges, 223, with margin, and still stalls against
-a wall instead of crushing through it). Densities are in each problem's own units, so a problem
-of heavier parts raises the clip to 1.5 times the friction of all its parts at its nominal
-(mid-range) friction and density (:func:`push_force`): only the noisy TT mating, whose
-densities reach 1.0, is affected (1608); its heaviest draws still stall the push, as the
-thesis's low-gain controller stalled.
+Defaults (:mod:`~arrange_up.physics.settings`): ``push_speed`` is a careful robot push whose
+travel per step stays far below the tunnelling limit of 1-inch blocks, and ``push_force`` pushes
+a chain of 7 blocks at the highest friction and density of the thesis's ranges and still stalls
+against a wall instead of crushing through it. A problem of heavier parts raises the clip to 1.5
+times the friction of all its parts at its nominal (mid-range) friction and density
+(:func:`push_force`); its heaviest draws can still stall the push, as the thesis's low-gain
+controller stalled. The figures behind both: ``docs/design/physics.md``.
 
 The compliant controller
 ========================
@@ -120,15 +118,15 @@ force and torque
 where the set point ``x_ref(t)`` moves from the approach pose along the push line at ``speed``
 and stops ``distance`` along it: the thesis's real robot fed its low-gain controller
 intermediate set points along the pushing line, updated with time (§2.4.2). A PD toward the
-distant end point with no speed limit would be a catapult (the paddle reached 65-110 in/s and
-throws blocks; see ``docs/design/physics.md``). The paddle has its own moment here (a compliant
+distant end point with no speed limit would be a catapult (it throws blocks:
+``docs/design/physics.md``). The paddle has its own moment here (a compliant
 wrist turns when a part meets it off-centre) and still no table friction. The drive runs until
 the set point has stopped and the paddle has been still (position and angle) for
 ``rest_checks`` checks; then the robot holds the paddle (a pivot and a gear joint with no bias,
 clipped at ``force`` and ``torque``: the brake) until the other bodies are at rest. Under the
 low gain a resisted push stops short by about the resisting friction / Kp, growing with friction
 x mass; a free push ends at its target without overshoot (semi-implicit Euler of a critically
-damped PD at ``sqrt(Kp / m) dt`` ~ 0.19). Defaults (``Kp = 300``) and their measurements:
+damped PD with ``sqrt(Kp / m) dt`` well below 1). Defaults (``Kp = 300``) and their measurements:
 ``docs/design/physics.md``. With ``PhysicsSettings.compliant_in_solver`` the same PD, set point
 and clips are built from constraints the engine solves (:class:`_SolverTracking`), not set from
 Python before every step.

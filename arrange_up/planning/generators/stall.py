@@ -120,8 +120,8 @@ class PushStall:
         (the stall changes little with the distance, so each step removes most of the error),
         stopping within ``SOLVER_TOLERANCE``. A simulation that does not end at rest, or a
         distance that falls to the free travel, keeps the last good distance."""
-        # Imported here: the physics (pymunk) costs ~55 ms to import, which importing the
-        # planner does not pay until a plan is made.
+        # Imported here: importing the physics (pymunk) is slow, and importing the planner
+        # should not pay for it until a plan is made.
         from arrange_up.physics.simulation import simulate
 
         state = WorldState(tuple((n, iv.center) for n, iv in belief.objects))
