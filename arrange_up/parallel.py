@@ -100,7 +100,9 @@ __all__ = [
     "available_cores",
     "check_runner_options",
     "get_runner",
+    "check_workers",
     "local_executor",
+    "max_workers",
     "shutdown",
 ]
 
@@ -121,6 +123,34 @@ def available_cores() -> int:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - not on Linux
         return os.cpu_count() or 1
+
+
+#: Worker processes allowed per core this process may use (:func:`max_workers`). The work is
+#: simulation, bound by the CPU: beyond one process per core more only compete for the cores
+#: and for memory (every worker imports numpy, shapely and pymunk, about 100 MB), and a
+#: mistyped count (``--workers 1024``) would start hundreds of processes. Four per core leave
+#: room for overlapping start-up and I/O.
+WORKERS_PER_CORE = 4
+
+
+def max_workers() -> int:
+    """The most worker processes a runner starts here: :data:`WORKERS_PER_CORE` per core this
+    process may use (:func:`available_cores`)."""
+    return WORKERS_PER_CORE * available_cores()
+
+
+def check_workers(workers: Any) -> None:
+    """Raise ``ValueError`` unless ``workers`` is a positive integer of at most
+    :func:`max_workers`; the message names the limit and why it exists."""
+    check_count("workers", workers)
+    limit = max_workers()
+    if workers > limit:
+        cores = available_cores()
+        raise ValueError(
+            f"workers must be at most {limit} ({WORKERS_PER_CORE} per core, {cores} "
+            f"core{'s' if cores != 1 else ''} here), got {workers}: more processes than "
+            "that only compete for the cores and memory"
+        )
 
 
 def _chunks(items: Iterable[T], size: int) -> Iterator[list[T]]:
@@ -290,7 +320,9 @@ def _watch_parent(parent: int) -> None:
 def local_executor(workers: int) -> Any:
     """The process's shared loky executor with ``workers`` processes (started on first use,
     reused afterwards; resized, not restarted, when the count changes). Its workers end when
-    this process does, however it ends (see :func:`_end_with_parent`)."""
+    this process does, however it ends (see :func:`_end_with_parent`). Raises ``ValueError``
+    for a count :func:`check_workers` refuses: every local pool starts here."""
+    check_workers(workers)
     # lazy: joblib's import is a start-up cost (docs/design/repair.md) that commands which
     # never start a pool must not pay
     from joblib.externals.loky import get_reusable_executor
@@ -586,13 +618,13 @@ def check_runner_options(
     backend: str = "local", workers: int | None = None, scheduler: str | None = None
 ) -> None:
     """Raise ``ValueError`` for an unknown backend, a worker count that is not a positive
-    integer, or a scheduler address without the dask backend; start nothing. A caller that
-    may not need a runner checks its options with this first, so that bad options fail alike
-    whether a runner is made or not."""
+    integer or is more than :func:`max_workers`, or a scheduler address without the dask
+    backend; start nothing. A caller that may not need a runner checks its options with this
+    first, so that bad options fail alike whether a runner is made or not."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
     if workers is not None:
-        check_count("workers", workers)
+        check_workers(workers)
     if scheduler is not None and backend != "dask":
         raise ValueError("a scheduler address needs the dask backend")
 

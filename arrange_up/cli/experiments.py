@@ -39,6 +39,7 @@ from arrange_up.cli.shared import (
     seed_option,
     terminal_progress,
     timeout_option,
+    workers_option,
 )
 from arrange_up.experiments import costs
 from arrange_up.experiments.csv_records import CsvRecordsError, read_csv
@@ -286,12 +287,7 @@ def _output_dir_option(csv: str) -> Any:
     help="Node limit of each planning run.",
 )
 @timeout_option("Planning time limit per run, seconds.")
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 256),
-    default=None,
-    help="Worker processes (default: all cores).",
-)
+@workers_option("Worker processes (default: all cores).")
 @_controller_option
 @_output_dir_option("transition-comparison.csv")
 @quiet_option()

@@ -23,6 +23,7 @@ from arrange_up.cli.shared import (
     read_plan_file,
     seed_option,
     terminal_progress,
+    workers_option,
     writing_output,
 )
 from arrange_up.io.planfile import write_json_atomic
@@ -107,12 +108,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     "only the approach back-off and the push multipliers, to measure how much of a repair's "
     "gain the fixtures themselves bring (recorded as \"fixtures\": false under 'repair').",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 256),
-    default=None,
-    help="Processes simulating particles (default: all cores).",
-)
+@workers_option("Processes simulating particles (default: all cores).")
 @click.option(
     "--output",
     "-o",

@@ -35,7 +35,7 @@ from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_m
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
-from arrange_up.parallel import BACKENDS
+from arrange_up.parallel import BACKENDS, WORKERS_PER_CORE, check_workers, max_workers
 from arrange_up.transitions import available
 
 EXIT_NEGATIVE = 1
@@ -138,6 +138,35 @@ def unwritable(path: Path) -> str | None:
     return None
 
 
+class WorkerCount(click.ParamType):
+    """A number of worker processes: a positive integer of at most
+    :func:`arrange_up.parallel.max_workers` (refused beyond, not capped: the command does what
+    it says or nothing)."""
+
+    name = "integer"
+
+    def convert(self, value: Any, param: Any, ctx: Any) -> Any:
+        number = click.INT.convert(value, param, ctx)
+        try:
+            check_workers(number)
+        except ValueError as error:
+            self.fail(str(error), param, ctx)
+        return number
+
+
+def workers_limit_help() -> str:
+    """The limit of every --workers option, as a sentence of its help."""
+    return f"At most {WORKERS_PER_CORE} per core ({max_workers()} here)."
+
+
+def workers_option(help: str) -> Callable[[Any], Any]:
+    """``--workers``: worker processes (:class:`WorkerCount`), default None; ``help`` says what
+    they run and the default, the limit's sentence follows."""
+    return click.option(
+        "--workers", type=WorkerCount(), default=None, help=f"{help} {workers_limit_help()}"
+    )
+
+
 def seed_option(help: str) -> Callable[[Any], Any]:
     """``--seed``: a non-negative integer, default 0; ``help`` says what it seeds."""
     return click.option("--seed", type=SEED, default=0, show_default=True, help=help)
@@ -237,12 +266,7 @@ def parallel_options(what: str) -> Callable[[Any], Any]:
     """The --workers, --backend and --scheduler options of commands that run batches of
     independent simulations (``what``: rollouts, examples, ...) on local processes or Dask."""
     options = (
-        click.option(
-            "--workers",
-            type=click.IntRange(1, 1024),
-            default=None,
-            help="Worker processes (default: all cores; 1 runs in this process).",
-        ),
+        workers_option("Worker processes (default: all cores; 1 runs in this process)."),
         click.option(
             "--backend",
             type=click.Choice(BACKENDS),
