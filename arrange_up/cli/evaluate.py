@@ -29,7 +29,7 @@ from arrange_up.cli.shared import (
     seed_option,
     terminal_progress,
 )
-from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS, evaluate_plan
 from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.evaluation.reliability import EvaluationProgress, FailureBreakdown
 from arrange_up.model.problem import ArrangementProblem, problem_hash
@@ -98,10 +98,10 @@ def _failure_lines(
 @click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
 @click.option(
     "--rollouts",
-    type=click.IntRange(1, None),
+    type=click.IntRange(1, MAX_ROLLOUTS),
     default=library_default(evaluate_plan, "rollouts"),
     show_default=True,
-    help="Noisy executions of the plan.",
+    help=f"Noisy executions of the plan (at most {MAX_ROLLOUTS:,}).",
 )
 @seed_option("Rollout i draws its noise from (seed, i): equal seeds give equal results.")
 @parallel_options("rollouts")

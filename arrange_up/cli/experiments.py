@@ -41,6 +41,7 @@ from arrange_up.cli.shared import (
     timeout_option,
     workers_option,
 )
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS
 from arrange_up.experiments import costs
 from arrange_up.experiments.csv_records import CsvRecordsError, read_csv
 from arrange_up.experiments.fixtures import (
@@ -274,7 +275,7 @@ def _output_dir_option(csv: str) -> Any:
 )
 @click.option(
     "--rollouts",
-    type=click.IntRange(0, 1_000_000),
+    type=click.IntRange(0, MAX_ROLLOUTS),
     default=library_default(transition_comparison, "rollouts"),
     show_default=True,
     help="Noisy rollouts per plan (0: no evaluation).",
@@ -492,7 +493,7 @@ def experiment_search_table(
 )
 @click.option(
     "--rollouts",
-    type=click.IntRange(0, 1_000_000),
+    type=click.IntRange(0, MAX_ROLLOUTS),
     default=library_default(fixture_experiment, "rollouts"),
     show_default=True,
     help="Noisy rollouts per nominal and per repaired plan (0: no evaluation).",
