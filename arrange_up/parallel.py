@@ -61,7 +61,10 @@ keeps the contexts it has unpickled, by digest, and a task that meets a worker w
 sent again with the pickle (so a worker respawned after :data:`IDLE_TIMEOUT` gets it again).
 A task lost with its worker (a crashed loky process, a Dask worker gone, its data lost) is
 submitted again, up to :data:`RETRIES` times; since results depend on ``(context, item)``
-only, a retried task gives the result the first attempt would have.
+only, a retried task gives the result the first attempt would have. Past the retries, and in
+:meth:`Runner.map` at once (a broken loky pool fails every task in flight; a lost Dask
+scheduler cancels them all), a lost worker raises :class:`WorkersLostError`, one line, in place
+of the library's exception.
 
 :func:`get_runner` caches runners, so repeated batches in one process reuse the same pool or
 cluster; :func:`shutdown` closes the cached Dask clients and clusters (the local pool is
@@ -91,6 +94,7 @@ from arrange_up.counts import check_count
 __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
+    "WorkersLostError",
     "DaskRunner",
     "LocalRunner",
     "Pending",
@@ -115,6 +119,31 @@ DASK_INSTALL_HINT = 'pip install "arrange-up[dask]"'
 
 class BackendUnavailableError(RuntimeError):
     """A backend was asked for whose libraries are not installed (or that cannot be reached)."""
+
+
+class WorkersLostError(RuntimeError):
+    """A batch cannot go on: its workers are gone (a local worker process killed or out of
+    memory, which breaks loky's pool; a Dask scheduler or worker lost, which cancels the
+    tasks). Raised by :meth:`Runner.map` in place of the library's exception (loky's
+    ``TerminatedWorkerError``, distributed's ``FutureCancelledError``, ...), and by a
+    session's :meth:`Pending.result` once its retries are spent; the message is one line
+    saying what was lost. The pairs :meth:`Runner.map` yielded before it stand: a caller
+    that recorded them (an evaluation's record file) keeps them, and says how to go on."""
+
+
+def _local_workers_lost(error: BaseException) -> WorkersLostError:
+    return WorkersLostError(
+        "a local worker process ended abruptly (killed, or out of memory), which broke the "
+        f"process pool ({type(error).__name__})"
+    )
+
+
+def _dask_workers_lost(error: BaseException) -> WorkersLostError:
+    reason = " ".join(str(error).split())  # distributed's messages may span lines
+    return WorkersLostError(
+        "the Dask cluster lost the batch's tasks (its scheduler or workers are gone): "
+        f"{type(error).__name__}{': ' + reason if reason else ''}"
+    )
 
 
 def available_cores() -> int:
@@ -348,6 +377,8 @@ class LocalRunner(Runner):
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
     ) -> Generator[tuple[T, R], None, None]:
+        from concurrent.futures.process import BrokenProcessPool
+
         _check_chunksize(chunksize)
         executor = local_executor(self.workers)
         chunks = _chunks(items, chunksize)
@@ -365,7 +396,10 @@ class LocalRunner(Runner):
                 done, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for future in done:
                     pending.discard(future)
-                    pairs = future.result()
+                    try:
+                        pairs = future.result()
+                    except BrokenProcessPool as error:  # loky's TerminatedWorkerError too
+                        raise _local_workers_lost(error) from error
                     following = next(chunks, None)
                     if following is not None:
                         submit(following)
@@ -432,10 +466,10 @@ class _LocalPending(Pending[R]):
         while True:
             try:
                 value = self.future.result()
-            except BrokenProcessPool:  # a worker died (killed, out of memory): the pool is
+            except BrokenProcessPool as error:  # a worker died (killed, out of memory): the pool is
                 self.attempts += 1  # rebuilt by the next local_executor call
                 if self.attempts > RETRIES:
-                    raise
+                    raise _local_workers_lost(error) from error
                 self._retry(with_context=True)
                 continue
             if isinstance(value, _ContextMissing):
@@ -521,7 +555,13 @@ class DaskRunner(Runner):
         try:
             for future in queue:
                 in_flight.discard(future)
-                pairs = future.result()
+                try:
+                    pairs = future.result()
+                except Exception as error:
+                    # an exception of fn itself is raised as it is
+                    if not _dask_lost(error):
+                        raise
+                    raise _dask_workers_lost(error) from error
                 following = next(chunks, None)
                 if following is not None:
                     queue.add(submit(following))
@@ -560,8 +600,10 @@ class _DaskPending(Pending[R]):
                 # A worker lost with the task or its context (KilledWorker, a cancelled or
                 # lost dependency): send again, re-scattering the context if need be. An
                 # exception of fn itself is raised on the first attempt.
-                if not self.session.lost(error) or self.attempts >= RETRIES:
+                if not _dask_lost(error):
                     raise
+                if self.attempts >= RETRIES:
+                    raise _dask_workers_lost(error) from error
                 self.attempts += 1
                 self.session.rescatter()
                 self.future = self.session.send(self.item)
@@ -583,20 +625,22 @@ class _DaskSession(Session[T, R]):
     def send(self, item: T) -> Any:
         return self.client.submit(self.fn, self.context_future, item, pure=False)
 
-    @staticmethod
-    def lost(error: BaseException) -> bool:
-        from distributed import KilledWorker
-        from distributed.client import FutureCancelledError
-
-        return isinstance(error, (KilledWorker, FutureCancelledError, OSError)) or (
-            type(error).__name__ in {"CancelledError", "FutureCancelledError"}
-        )
-
     def submit(self, item: T) -> Pending[R]:
         return _DaskPending(self, item)
 
     def close(self) -> None:
         self.context_future.release()
+
+
+def _dask_lost(error: BaseException) -> bool:
+    """Whether a Dask task failed because its worker, its data or the scheduler was lost (not
+    because its function raised)."""
+    from distributed import KilledWorker
+    from distributed.client import FutureCancelledError
+
+    return isinstance(error, (KilledWorker, FutureCancelledError, OSError)) or (
+        type(error).__name__ in {"CancelledError", "FutureCancelledError"}
+    )
 
 
 def _import_distributed() -> Any:

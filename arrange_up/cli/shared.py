@@ -15,6 +15,7 @@ import inspect
 import json
 import math
 import os
+import shlex
 import signal
 import sys
 import tempfile
@@ -46,6 +47,25 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
     """Print ``arrange-up: message`` on stderr and exit with ``code`` (default: bad input)."""
     click.echo(f"arrange-up: {message}", err=True)
     sys.exit(code)
+
+
+def command_line() -> str:
+    """The running command as it was given (``arrange-up`` and its arguments, quoted for a
+    POSIX shell), for a message that says to run it again; ``arrange-up`` alone outside a
+    command."""
+    from arrange_up.cli import ARGV_KEY
+
+    ctx = click.get_current_context(silent=True)
+    given = ctx.meta.get(ARGV_KEY, []) if ctx is not None else []
+    return shlex.join(["arrange-up", *given])
+
+
+def stopped_early(error: BaseException, kept: str, code: int = EXIT_NEGATIVE) -> NoReturn:
+    """End a command whose workers were lost (:class:`arrange_up.parallel.WorkersLostError`)
+    in one line: the error, then ``kept`` (what the command kept and how to go on, ending with
+    "run again ..."), then the command to run, :func:`command_line`; exit status ``code`` (1,
+    as an interrupt: the job ran, not to its end)."""
+    fail(f"{error}{kept}: {command_line()}", code)
 
 
 @contextmanager
