@@ -37,6 +37,7 @@ from arrange_up.cli.shared import (
     parallel_options,
     quiet_option,
     seed_option,
+    stopped_early,
     terminal_progress,
     timeout_option,
     workers_option,
@@ -70,7 +71,7 @@ from arrange_up.experiments.planning import (
     transition_markdown,
 )
 from arrange_up.model.problem import ControllerKind
-from arrange_up.parallel import BackendUnavailableError, RunnerConfig
+from arrange_up.parallel import BackendUnavailableError, RunnerConfig, WorkersLostError
 from arrange_up.repair import METHODS
 from arrange_up.transitions import available
 
@@ -235,6 +236,11 @@ def _interrupted(csv: Path) -> None:
     fail(f"interrupted; the rows measured so far are in {csv}: run again to resume", EXIT_NEGATIVE)
 
 
+def _workers_lost(error: WorkersLostError, csv: Path) -> None:
+    """Exit 1 after the workers were lost, saying where the rows so far are and what resumes."""
+    stopped_early(error, f"; the rows measured so far are in {csv}: run again to resume")
+
+
 def _output_dir_option(csv: str) -> Any:
     """``--output-dir`` of an experiment that writes ``csv`` and its picture there."""
     return click.option(
@@ -360,6 +366,8 @@ def experiment_transition_comparison(
             )
     except KeyboardInterrupt:
         _interrupted(Path(output_dir) / "transition-comparison.csv")
+    except WorkersLostError as error:
+        _workers_lost(error, Path(output_dir) / "transition-comparison.csv")
     except CsvRecordsError as error:
         fail(str(error))
     rows = select_transition_rows(read_csv(path), names, [p.label for p in planners], runs)
@@ -464,6 +472,8 @@ def experiment_search_table(
             )
     except KeyboardInterrupt:
         _interrupted(Path(output_dir) / "search-table.csv")
+    except WorkersLostError as error:
+        _workers_lost(error, Path(output_dir) / "search-table.csv")
     except CsvRecordsError as error:
         fail(str(error))
     click.echo(search_markdown(select_search_rows(read_csv(path), names, semantics)))
@@ -624,6 +634,8 @@ def experiment_fixtures(
             )
     except KeyboardInterrupt:
         _interrupted(Path(output_dir) / CSV_NAME)
+    except WorkersLostError as error:
+        _workers_lost(error, Path(output_dir) / CSV_NAME)
     except (StaleResultsError, BackendUnavailableError, ValueError) as error:
         fail(str(error))
     rows = select_rows(

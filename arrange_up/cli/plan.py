@@ -26,13 +26,19 @@ from arrange_up.cli.shared import (
     parallel_options,
     quiet_option,
     seed_option,
+    stopped_early,
     terminal_progress,
     writing_output,
 )
 from arrange_up.evaluation.evaluate import MAX_ROLLOUTS
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.parallel import BackendUnavailableError, RunnerConfig, available_cores
+from arrange_up.parallel import (
+    BackendUnavailableError,
+    RunnerConfig,
+    WorkersLostError,
+    available_cores,
+)
 from arrange_up.planning.config import DEFAULT_MAX_NODES, DEFAULT_WEIGHT, PlanConfig, SearchConfig
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import plan as run_plan
@@ -264,6 +270,8 @@ def plan(
         fail(f"--model {model}: {error}")
     except KeyboardInterrupt:  # the second Ctrl-C
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
+    except WorkersLostError as error:
+        stopped_early(error, "; no plan was written: run again")
     document = result.document(loaded, model)
     if output:
         with writing_output(output):
