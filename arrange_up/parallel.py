@@ -29,7 +29,8 @@ Backends
   process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
   seconds and respawned by the next batch. Each worker watches its parent
   (:func:`_end_with_parent`) and ends within :data:`PARENT_POLL` seconds of the parent's
-  death, even a SIGKILL that gives the parent no chance to stop its pool. Workers ignore
+  death, even a SIGKILL that gives the parent no chance to stop its pool, and one that comes
+  while the workers still start (they end as their start-up does). Workers ignore
   SIGINT (:func:`_init_worker`): interrupting is the parent's; interrupting a batch cancels
   its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
   executor wrapper cannot take over an executor that ``get_reusable_executor`` created, so
@@ -335,9 +336,26 @@ def _end_with_parent(parent: int) -> None:
     unlike Linux's ``PR_SET_PDEATHSIG``, which fires when the *thread* that started the
     worker ends, and loky starts workers from its own threads too).
     """
-    if os.getppid() != parent:  # started through an intermediate process: nothing to watch
+    if os.getppid() != parent:
+        # Killed while this worker started (loky starts workers as its direct children, and
+        # the initializer runs only after the worker's imports, a second or more): the parent
+        # is gone already and nothing would end this orphan (it lived 40-50 s). A parent
+        # that still exists started it through an intermediate process: nothing to watch.
+        if not _exists(parent):
+            os._exit(1)
         return
     threading.Thread(target=_watch_parent, args=(parent,), name="parent-watch", daemon=True).start()
+
+
+def _exists(pid: int) -> bool:
+    """Whether process ``pid`` exists (signal 0 checks without sending anything)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # pragma: no cover - exists, owned by another user
+        return True
+    return True
 
 
 def _watch_parent(parent: int) -> None:
