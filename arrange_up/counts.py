@@ -22,13 +22,16 @@ def is_number(value: object) -> TypeGuard[float]:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def check_count(name: str, value: Any, minimum: int | None = 1) -> None:
+def check_count(name: str, value: Any, minimum: int | None = 1, maximum: int | None = None) -> None:
     """Raise ``ValueError`` unless ``value`` is an integer (not a ``bool``) of at least
     ``minimum`` (``None``: any integer). The message names ``name`` and what was expected:
     ``"{name} must be a positive integer, got {value!r}"`` for a minimum of 1,
     ``"... a non-negative integer ..."`` for 0, ``"... an integer ..."`` for ``None`` and
-    ``"... an integer of at least {minimum} ..."`` otherwise."""
+    ``"... an integer of at least {minimum} ..."`` otherwise; with a ``maximum``, a larger
+    integer gives ``"{name} must be at most {maximum:,}, got {value!r}"``."""
     if is_integer(value) and (minimum is None or value >= minimum):
+        if maximum is not None and value > maximum:
+            raise ValueError(f"{name} must be at most {maximum:,}, got {value!r}")
         return
     expected = {None: "an integer", 0: "a non-negative integer", 1: "a positive integer"}.get(
         minimum, f"an integer of at least {minimum}"

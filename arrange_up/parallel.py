@@ -29,7 +29,8 @@ Backends
   process's only worker pool. Idle workers are reaped after :data:`IDLE_TIMEOUT`
   seconds and respawned by the next batch. Each worker watches its parent
   (:func:`_end_with_parent`) and ends within :data:`PARENT_POLL` seconds of the parent's
-  death, even a SIGKILL that gives the parent no chance to stop its pool. Workers ignore
+  death, even a SIGKILL that gives the parent no chance to stop its pool, and one that comes
+  while the workers still start (they end as their start-up does). Workers ignore
   SIGINT (:func:`_init_worker`): interrupting is the parent's; interrupting a batch cancels
   its queued tasks and leaves the pool up. (Not ``joblib.Parallel``: its
   executor wrapper cannot take over an executor that ``get_reusable_executor`` created, so
@@ -61,7 +62,10 @@ keeps the contexts it has unpickled, by digest, and a task that meets a worker w
 sent again with the pickle (so a worker respawned after :data:`IDLE_TIMEOUT` gets it again).
 A task lost with its worker (a crashed loky process, a Dask worker gone, its data lost) is
 submitted again, up to :data:`RETRIES` times; since results depend on ``(context, item)``
-only, a retried task gives the result the first attempt would have.
+only, a retried task gives the result the first attempt would have. Past the retries, and in
+:meth:`Runner.map` at once (a broken loky pool fails every task in flight; a lost Dask
+scheduler cancels them all), a lost worker raises :class:`WorkersLostError`, one line, in place
+of the library's exception.
 
 :func:`get_runner` caches runners, so repeated batches in one process reuse the same pool or
 cluster; :func:`shutdown` closes the cached Dask clients and clusters (the local pool is
@@ -91,6 +95,7 @@ from arrange_up.counts import check_count
 __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
+    "WorkersLostError",
     "DaskRunner",
     "LocalRunner",
     "Pending",
@@ -100,7 +105,9 @@ __all__ = [
     "available_cores",
     "check_runner_options",
     "get_runner",
+    "check_workers",
     "local_executor",
+    "max_workers",
     "shutdown",
 ]
 
@@ -115,12 +122,65 @@ class BackendUnavailableError(RuntimeError):
     """A backend was asked for whose libraries are not installed (or that cannot be reached)."""
 
 
+class WorkersLostError(RuntimeError):
+    """A batch cannot go on: its workers are gone (a local worker process killed or out of
+    memory, which breaks loky's pool; a Dask scheduler or worker lost, which cancels the
+    tasks). Raised by :meth:`Runner.map` in place of the library's exception (loky's
+    ``TerminatedWorkerError``, distributed's ``FutureCancelledError``, ...), and by a
+    session's :meth:`Pending.result` once its retries are spent; the message is one line
+    saying what was lost. The pairs :meth:`Runner.map` yielded before it stand: a caller
+    that recorded them (an evaluation's record file) keeps them, and says how to go on."""
+
+
+def _local_workers_lost(error: BaseException) -> WorkersLostError:
+    return WorkersLostError(
+        "a local worker process ended abruptly (killed, or out of memory), which broke the "
+        f"process pool ({type(error).__name__})"
+    )
+
+
+def _dask_workers_lost(error: BaseException) -> WorkersLostError:
+    reason = " ".join(str(error).split())  # distributed's messages may span lines
+    return WorkersLostError(
+        "the Dask cluster lost the batch's tasks (its scheduler or workers are gone): "
+        f"{type(error).__name__}{': ' + reason if reason else ''}"
+    )
+
+
 def available_cores() -> int:
     """Cores this process may run on (``os.sched_getaffinity``), at least 1."""
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - not on Linux
         return os.cpu_count() or 1
+
+
+#: Worker processes allowed per core this process may use (:func:`max_workers`). The work is
+#: simulation, bound by the CPU: beyond one process per core more only compete for the cores
+#: and for memory (every worker imports numpy, shapely and pymunk, about 100 MB), and a
+#: mistyped count (``--workers 1024``) would start hundreds of processes. Four per core leave
+#: room for overlapping start-up and I/O.
+WORKERS_PER_CORE = 4
+
+
+def max_workers() -> int:
+    """The most worker processes a runner starts here: :data:`WORKERS_PER_CORE` per core this
+    process may use (:func:`available_cores`)."""
+    return WORKERS_PER_CORE * available_cores()
+
+
+def check_workers(workers: Any) -> None:
+    """Raise ``ValueError`` unless ``workers`` is a positive integer of at most
+    :func:`max_workers`; the message names the limit and why it exists."""
+    check_count("workers", workers)
+    limit = max_workers()
+    if workers > limit:
+        cores = available_cores()
+        raise ValueError(
+            f"workers must be at most {limit} ({WORKERS_PER_CORE} per core, {cores} "
+            f"core{'s' if cores != 1 else ''} here), got {workers}: more processes than "
+            "that only compete for the cores and memory"
+        )
 
 
 def _chunks(items: Iterable[T], size: int) -> Iterator[list[T]]:
@@ -276,9 +336,26 @@ def _end_with_parent(parent: int) -> None:
     unlike Linux's ``PR_SET_PDEATHSIG``, which fires when the *thread* that started the
     worker ends, and loky starts workers from its own threads too).
     """
-    if os.getppid() != parent:  # started through an intermediate process: nothing to watch
+    if os.getppid() != parent:
+        # Killed while this worker started (loky starts workers as its direct children, and
+        # the initializer runs only after the worker's imports, a second or more): the parent
+        # is gone already and nothing would end this orphan (it lived 40-50 s). A parent
+        # that still exists started it through an intermediate process: nothing to watch.
+        if not _exists(parent):
+            os._exit(1)
         return
     threading.Thread(target=_watch_parent, args=(parent,), name="parent-watch", daemon=True).start()
+
+
+def _exists(pid: int) -> bool:
+    """Whether process ``pid`` exists (signal 0 checks without sending anything)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # pragma: no cover - exists, owned by another user
+        return True
+    return True
 
 
 def _watch_parent(parent: int) -> None:
@@ -290,7 +367,9 @@ def _watch_parent(parent: int) -> None:
 def local_executor(workers: int) -> Any:
     """The process's shared loky executor with ``workers`` processes (started on first use,
     reused afterwards; resized, not restarted, when the count changes). Its workers end when
-    this process does, however it ends (see :func:`_end_with_parent`)."""
+    this process does, however it ends (see :func:`_end_with_parent`). Raises ``ValueError``
+    for a count :func:`check_workers` refuses: every local pool starts here."""
+    check_workers(workers)
     # lazy: joblib's import is a start-up cost (docs/design/repair.md) that commands which
     # never start a pool must not pay
     from joblib.externals.loky import get_reusable_executor
@@ -316,6 +395,8 @@ class LocalRunner(Runner):
     def map(
         self, fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1
     ) -> Generator[tuple[T, R], None, None]:
+        from concurrent.futures.process import BrokenProcessPool
+
         _check_chunksize(chunksize)
         executor = local_executor(self.workers)
         chunks = _chunks(items, chunksize)
@@ -333,7 +414,10 @@ class LocalRunner(Runner):
                 done, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for future in done:
                     pending.discard(future)
-                    pairs = future.result()
+                    try:
+                        pairs = future.result()
+                    except BrokenProcessPool as error:  # loky's TerminatedWorkerError too
+                        raise _local_workers_lost(error) from error
                     following = next(chunks, None)
                     if following is not None:
                         submit(following)
@@ -400,10 +484,10 @@ class _LocalPending(Pending[R]):
         while True:
             try:
                 value = self.future.result()
-            except BrokenProcessPool:  # a worker died (killed, out of memory): the pool is
+            except BrokenProcessPool as error:  # a worker died (killed, out of memory): the pool is
                 self.attempts += 1  # rebuilt by the next local_executor call
                 if self.attempts > RETRIES:
-                    raise
+                    raise _local_workers_lost(error) from error
                 self._retry(with_context=True)
                 continue
             if isinstance(value, _ContextMissing):
@@ -489,7 +573,13 @@ class DaskRunner(Runner):
         try:
             for future in queue:
                 in_flight.discard(future)
-                pairs = future.result()
+                try:
+                    pairs = future.result()
+                except Exception as error:
+                    # an exception of fn itself is raised as it is
+                    if not _dask_lost(error):
+                        raise
+                    raise _dask_workers_lost(error) from error
                 following = next(chunks, None)
                 if following is not None:
                     queue.add(submit(following))
@@ -528,8 +618,10 @@ class _DaskPending(Pending[R]):
                 # A worker lost with the task or its context (KilledWorker, a cancelled or
                 # lost dependency): send again, re-scattering the context if need be. An
                 # exception of fn itself is raised on the first attempt.
-                if not self.session.lost(error) or self.attempts >= RETRIES:
+                if not _dask_lost(error):
                     raise
+                if self.attempts >= RETRIES:
+                    raise _dask_workers_lost(error) from error
                 self.attempts += 1
                 self.session.rescatter()
                 self.future = self.session.send(self.item)
@@ -551,20 +643,22 @@ class _DaskSession(Session[T, R]):
     def send(self, item: T) -> Any:
         return self.client.submit(self.fn, self.context_future, item, pure=False)
 
-    @staticmethod
-    def lost(error: BaseException) -> bool:
-        from distributed import KilledWorker
-        from distributed.client import FutureCancelledError
-
-        return isinstance(error, (KilledWorker, FutureCancelledError, OSError)) or (
-            type(error).__name__ in {"CancelledError", "FutureCancelledError"}
-        )
-
     def submit(self, item: T) -> Pending[R]:
         return _DaskPending(self, item)
 
     def close(self) -> None:
         self.context_future.release()
+
+
+def _dask_lost(error: BaseException) -> bool:
+    """Whether a Dask task failed because its worker, its data or the scheduler was lost (not
+    because its function raised)."""
+    from distributed import KilledWorker
+    from distributed.client import FutureCancelledError
+
+    return isinstance(error, (KilledWorker, FutureCancelledError, OSError)) or (
+        type(error).__name__ in {"CancelledError", "FutureCancelledError"}
+    )
 
 
 def _import_distributed() -> Any:
@@ -586,13 +680,13 @@ def check_runner_options(
     backend: str = "local", workers: int | None = None, scheduler: str | None = None
 ) -> None:
     """Raise ``ValueError`` for an unknown backend, a worker count that is not a positive
-    integer, or a scheduler address without the dask backend; start nothing. A caller that
-    may not need a runner checks its options with this first, so that bad options fail alike
-    whether a runner is made or not."""
+    integer or is more than :func:`max_workers`, or a scheduler address without the dask
+    backend; start nothing. A caller that may not need a runner checks its options with this
+    first, so that bad options fail alike whether a runner is made or not."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; expected one of {', '.join(BACKENDS)}")
     if workers is not None:
-        check_count("workers", workers)
+        check_workers(workers)
     if scheduler is not None and backend != "dask":
         raise ValueError("a scheduler address needs the dask backend")
 

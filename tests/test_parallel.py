@@ -178,3 +178,48 @@ def test_workers_end_when_their_parent_is_killed():
     while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not any(_alive(pid) for pid in workers)
+
+
+_ORPHANS_AT_START = """
+import os, time
+from arrange_up.parallel import local_executor
+executor = local_executor(2)
+futures = [executor.submit(time.sleep, 5) for _ in range(4)]
+time.sleep(0.2)  # the workers are still importing: their initializer has not run
+me, children = os.getpid(), []
+for pid in filter(str.isdigit, os.listdir("/proc")):
+    try:
+        with open(f"/proc/{pid}/stat") as handle:
+            if int(handle.read().rsplit(")", 1)[1].split()[1]) == me:
+                children.append(pid)
+    except OSError:
+        pass
+print(" ".join(children), flush=True)
+time.sleep(60)
+"""
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="lists the parent's children in /proc")
+def test_workers_end_when_their_parent_is_killed_while_they_start():
+    # killed 0.2 s after start, before the workers' initializer ran: they lived 40-50 s
+    import signal
+    import subprocess
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    parent = subprocess.Popen(
+        [sys.executable, "-c", _ORPHANS_AT_START], stdout=subprocess.PIPE, text=True, cwd=root
+    )
+    try:
+        children = [int(pid) for pid in parent.stdout.readline().split()]
+        assert len(children) >= 2
+    finally:
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+    deadline = time.monotonic() + 10.0
+    while any(_alive(pid) for pid in children) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    left = [pid for pid in children if _alive(pid)]
+    for pid in left:  # do not leave them behind when the test fails
+        os.kill(pid, signal.SIGKILL)
+    assert not left

@@ -15,6 +15,7 @@ This module holds only the top-level group, :func:`main`.
 from __future__ import annotations
 
 import importlib
+from typing import Any
 
 import click
 
@@ -93,8 +94,26 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
 }
 
 
+#: The key of the context's ``meta`` under which the group keeps the arguments it was given.
+ARGV_KEY = "arrange_up.argv"
+
+
 class _LazyGroup(click.Group):
     """A group whose commands are listed from :data:`COMMANDS` and imported when resolved."""
+
+    def make_context(
+        self,
+        info_name: str | None,
+        args: list[str],
+        parent: click.Context | None = None,
+        **extra: Any,
+    ) -> click.Context:
+        # the arguments as given, before parsing consumes them: a command that stops early
+        # says how to run it again (shared.command_line)
+        given = list(args)
+        ctx = super().make_context(info_name, args, parent, **extra)
+        ctx.meta[ARGV_KEY] = given
+        return ctx
 
     def list_commands(self, ctx: click.Context) -> list[str]:
         return sorted({*self.commands, *COMMANDS})

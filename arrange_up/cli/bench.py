@@ -7,9 +7,12 @@ import click
 from arrange_up.cli.shared import (
     comma_integers,
     comma_separated,
+    fail,
     library_default,
     seed_option,
+    workers_limit_help,
 )
+from arrange_up.parallel import check_workers
 from arrange_up.physics.bench import bench_physics
 
 
@@ -31,7 +34,7 @@ def bench() -> None:
     type=str,
     default=comma_separated(library_default(bench_physics, "workers")),
     show_default=True,
-    help="Comma-separated process counts to measure.",
+    help=f"Comma-separated process counts to measure. {workers_limit_help()}",
 )
 @seed_option("Seeds the noise of the pushes.")
 def bench_physics_command(pushes: int, workers: str, seed: int) -> None:
@@ -40,6 +43,11 @@ def bench_physics_command(pushes: int, workers: str, seed: int) -> None:
     Each push is a full place-to-rest simulation in a fresh space at dt 1/240 s.
     """
     counts = tuple(comma_integers("--workers", workers))
+    for count in counts:
+        try:
+            check_workers(count)
+        except ValueError as error:
+            fail(f"--workers: {error}")
     rows = bench_physics(
         n_pushes=pushes, workers=counts, seed=seed, progress=lambda msg: click.echo(msg, err=True)
     )

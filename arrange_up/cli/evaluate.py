@@ -27,14 +27,15 @@ from arrange_up.cli.shared import (
     quiet_option,
     read_plan_file,
     seed_option,
+    stopped_early,
     terminal_progress,
 )
-from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS, evaluate_plan
 from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.evaluation.reliability import EvaluationProgress, FailureBreakdown
 from arrange_up.model.problem import ArrangementProblem, problem_hash
 from arrange_up.model.world import Action, Push
-from arrange_up.parallel import BackendUnavailableError, RunnerConfig
+from arrange_up.parallel import BackendUnavailableError, RunnerConfig, WorkersLostError
 
 
 def _describe_action(actions: Sequence[Action], index: int) -> str:
@@ -98,10 +99,10 @@ def _failure_lines(
 @click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
 @click.option(
     "--rollouts",
-    type=click.IntRange(1, None),
+    type=click.IntRange(1, MAX_ROLLOUTS),
     default=library_default(evaluate_plan, "rollouts"),
     show_default=True,
-    help="Noisy executions of the plan.",
+    help=f"Noisy executions of the plan (at most {MAX_ROLLOUTS:,}).",
 )
 @seed_option("Rollout i draws its noise from (seed, i): equal seeds give equal results.")
 @parallel_options("rollouts")
@@ -142,7 +143,9 @@ def evaluate(
       arrange-up evaluate blocks-4 b4.json --landing shove
       arrange-up evaluate blocks-4 b4.json --backend dask --scheduler tcp://10.0.0.5:8786
 
-    Exit status: 0 the evaluation ran (whatever the rate), 1 interrupted, 2 bad input.
+    Exit status: 0 the evaluation ran (whatever the rate), 1 interrupted or its workers lost
+    (a worker process killed, a Dask scheduler gone: the rollouts recorded with --record are
+    kept, and running the command again resumes), 2 bad input.
     """
     backend = backend_choice(backend, scheduler)
     loaded = load_problem(problem)
@@ -155,13 +158,18 @@ def evaluate(
         TimeElapsedColumn(),
         TimeRemainingColumn(),
     )
+    done = [0]  # rollouts finished (resumed ones included), for a message if the run stops
     try:
         with terminal_progress(*columns, what="evaluate", quiet=quiet) as display:
-            update = None
-            if display is not None:
-                task = display.add_task("rollouts", total=rollouts, summary="")
+            task = (
+                None
+                if display is None
+                else display.add_task("rollouts", total=rollouts, summary="")
+            )
 
-                def update(state: EvaluationProgress) -> None:
+            def update(state: EvaluationProgress) -> None:
+                done[0] = state.done
+                if display is not None and task is not None:
                     summary = f"{state.successes} ok ({100.0 * state.rate:.1f}%)"
                     display.update(task, completed=state.done, summary=summary)
 
@@ -178,6 +186,12 @@ def evaluate(
     except KeyboardInterrupt:
         kept = f"; the finished rollouts are in {record}: run again to resume" if record else ""
         fail(f"interrupted{kept}", EXIT_NEGATIVE)
+    except WorkersLostError as error:
+        if record:
+            kept = f"; the {done[0]} finished rollouts are in {record}: run again to resume"
+        else:
+            kept = "; no rollout was kept (--record FILE keeps them to resume): run again"
+        stopped_early(error, kept)
     except (RecordFileError, BackendUnavailableError, ValueError) as error:
         fail(str(error))
     low, high = result.interval

@@ -37,9 +37,12 @@ from arrange_up.cli.shared import (
     parallel_options,
     quiet_option,
     seed_option,
+    stopped_early,
     terminal_progress,
     timeout_option,
+    workers_option,
 )
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS
 from arrange_up.experiments import costs
 from arrange_up.experiments.csv_records import CsvRecordsError, read_csv
 from arrange_up.experiments.fixtures import (
@@ -68,7 +71,7 @@ from arrange_up.experiments.planning import (
     transition_markdown,
 )
 from arrange_up.model.problem import ControllerKind
-from arrange_up.parallel import BackendUnavailableError, RunnerConfig
+from arrange_up.parallel import BackendUnavailableError, RunnerConfig, WorkersLostError
 from arrange_up.repair import METHODS
 from arrange_up.transitions import available
 
@@ -233,6 +236,11 @@ def _interrupted(csv: Path) -> None:
     fail(f"interrupted; the rows measured so far are in {csv}: run again to resume", EXIT_NEGATIVE)
 
 
+def _workers_lost(error: WorkersLostError, csv: Path) -> None:
+    """Exit 1 after the workers were lost, saying where the rows so far are and what resumes."""
+    stopped_early(error, f"; the rows measured so far are in {csv}: run again to resume")
+
+
 def _output_dir_option(csv: str) -> Any:
     """``--output-dir`` of an experiment that writes ``csv`` and its picture there."""
     return click.option(
@@ -273,7 +281,7 @@ def _output_dir_option(csv: str) -> Any:
 )
 @click.option(
     "--rollouts",
-    type=click.IntRange(0, 1_000_000),
+    type=click.IntRange(0, MAX_ROLLOUTS),
     default=library_default(transition_comparison, "rollouts"),
     show_default=True,
     help="Noisy rollouts per plan (0: no evaluation).",
@@ -286,12 +294,7 @@ def _output_dir_option(csv: str) -> Any:
     help="Node limit of each planning run.",
 )
 @timeout_option("Planning time limit per run, seconds.")
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 256),
-    default=None,
-    help="Worker processes (default: all cores).",
-)
+@workers_option("Worker processes (default: all cores).")
 @_controller_option
 @_output_dir_option("transition-comparison.csv")
 @quiet_option()
@@ -363,6 +366,8 @@ def experiment_transition_comparison(
             )
     except KeyboardInterrupt:
         _interrupted(Path(output_dir) / "transition-comparison.csv")
+    except WorkersLostError as error:
+        _workers_lost(error, Path(output_dir) / "transition-comparison.csv")
     except CsvRecordsError as error:
         fail(str(error))
     rows = select_transition_rows(read_csv(path), names, [p.label for p in planners], runs)
@@ -467,6 +472,8 @@ def experiment_search_table(
             )
     except KeyboardInterrupt:
         _interrupted(Path(output_dir) / "search-table.csv")
+    except WorkersLostError as error:
+        _workers_lost(error, Path(output_dir) / "search-table.csv")
     except CsvRecordsError as error:
         fail(str(error))
     click.echo(search_markdown(select_search_rows(read_csv(path), names, semantics)))
@@ -496,7 +503,7 @@ def experiment_search_table(
 )
 @click.option(
     "--rollouts",
-    type=click.IntRange(0, 1_000_000),
+    type=click.IntRange(0, MAX_ROLLOUTS),
     default=library_default(fixture_experiment, "rollouts"),
     show_default=True,
     help="Noisy rollouts per nominal and per repaired plan (0: no evaluation).",
@@ -627,6 +634,8 @@ def experiment_fixtures(
             )
     except KeyboardInterrupt:
         _interrupted(Path(output_dir) / CSV_NAME)
+    except WorkersLostError as error:
+        _workers_lost(error, Path(output_dir) / CSV_NAME)
     except (StaleResultsError, BackendUnavailableError, ValueError) as error:
         fail(str(error))
     rows = select_rows(

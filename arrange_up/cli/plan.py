@@ -26,12 +26,19 @@ from arrange_up.cli.shared import (
     parallel_options,
     quiet_option,
     seed_option,
+    stopped_early,
     terminal_progress,
     writing_output,
 )
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.parallel import BackendUnavailableError, RunnerConfig, available_cores
+from arrange_up.parallel import (
+    BackendUnavailableError,
+    RunnerConfig,
+    WorkersLostError,
+    available_cores,
+)
 from arrange_up.planning.config import DEFAULT_MAX_NODES, DEFAULT_WEIGHT, PlanConfig, SearchConfig
 from arrange_up.planning.heuristics import HEURISTICS
 from arrange_up.planning.planner import plan as run_plan
@@ -133,12 +140,13 @@ def _check_model(problem: ArrangementProblem, model: str | None) -> None:
 )
 @click.option(
     "--validate",
-    type=click.IntRange(0, None),
+    type=click.IntRange(0, MAX_ROLLOUTS),
     default=None,
     help="Check a found plan on this many fresh rollouts (new initial states and noise, "
     "judged as evaluate judges them). Particle semantics: when some fail, search again with "
     "their initial states added to the particles, up to 3 more times, and return the plan "
-    "that did best; other semantics report how the one plan did. 0 turns it off. [default: "
+    "that did best; other semantics report how the one plan did. 0 turns it off; at most "
+    f"{MAX_ROLLOUTS:,}. [default: "
     "twice --particles, at least 60; 60 for cbst; off for deterministic]",
 )
 @parallel_options("simulations of the successors the search will evaluate next")
@@ -262,6 +270,8 @@ def plan(
         fail(f"--model {model}: {error}")
     except KeyboardInterrupt:  # the second Ctrl-C
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
+    except WorkersLostError as error:
+        stopped_early(error, "; no plan was written: run again")
     document = result.document(loaded, model)
     if output:
         with writing_output(output):

@@ -22,12 +22,14 @@ from arrange_up.cli.shared import (
     quiet_option,
     read_plan_file,
     seed_option,
+    stopped_early,
     terminal_progress,
+    workers_option,
     writing_output,
 )
 from arrange_up.io.planfile import write_json_atomic
 from arrange_up.model.problem import ArrangementProblem
-from arrange_up.parallel import available_cores
+from arrange_up.parallel import WorkersLostError, available_cores
 from arrange_up.repair import (
     DEFAULT_PARTICLES,
     METHODS,
@@ -107,12 +109,7 @@ def _step_lines(problem: ArrangementProblem, result: RepairResult) -> list[str]:
     "only the approach back-off and the push multipliers, to measure how much of a repair's "
     "gain the fixtures themselves bring (recorded as \"fixtures\": false under 'repair').",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(1, 256),
-    default=None,
-    help="Processes simulating particles (default: all cores).",
-)
+@workers_option("Processes simulating particles (default: all cores).")
 @click.option(
     "--output",
     "-o",
@@ -188,6 +185,8 @@ def repair(
             )
     except KeyboardInterrupt:
         fail("interrupted; no plan was written", EXIT_NEGATIVE)
+    except WorkersLostError as error:
+        stopped_early(error, "; no plan was written: run again")
     except ValueError as error:
         fail(str(error))
     document = result.document(loaded)

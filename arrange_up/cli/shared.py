@@ -15,6 +15,7 @@ import inspect
 import json
 import math
 import os
+import shlex
 import signal
 import sys
 import tempfile
@@ -35,7 +36,7 @@ from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_m
 from arrange_up.model.errors import ProblemFormatError
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
-from arrange_up.parallel import BACKENDS
+from arrange_up.parallel import BACKENDS, WORKERS_PER_CORE, check_workers, max_workers
 from arrange_up.transitions import available
 
 EXIT_NEGATIVE = 1
@@ -46,6 +47,25 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
     """Print ``arrange-up: message`` on stderr and exit with ``code`` (default: bad input)."""
     click.echo(f"arrange-up: {message}", err=True)
     sys.exit(code)
+
+
+def command_line() -> str:
+    """The running command as it was given (``arrange-up`` and its arguments, quoted for a
+    POSIX shell), for a message that says to run it again; ``arrange-up`` alone outside a
+    command."""
+    from arrange_up.cli import ARGV_KEY
+
+    ctx = click.get_current_context(silent=True)
+    given = ctx.meta.get(ARGV_KEY, []) if ctx is not None else []
+    return shlex.join(["arrange-up", *given])
+
+
+def stopped_early(error: BaseException, kept: str, code: int = EXIT_NEGATIVE) -> NoReturn:
+    """End a command whose workers were lost (:class:`arrange_up.parallel.WorkersLostError`)
+    in one line: the error, then ``kept`` (what the command kept and how to go on, ending with
+    "run again ..."), then the command to run, :func:`command_line`; exit status ``code`` (1,
+    as an interrupt: the job ran, not to its end)."""
+    fail(f"{error}{kept}: {command_line()}", code)
 
 
 @contextmanager
@@ -136,6 +156,35 @@ def unwritable(path: Path) -> str | None:
     except OSError as error:
         return f"no file can be created in {folder} ({error.strerror or error})"
     return None
+
+
+class WorkerCount(click.ParamType):
+    """A number of worker processes: a positive integer of at most
+    :func:`arrange_up.parallel.max_workers` (refused beyond, not capped: the command does what
+    it says or nothing)."""
+
+    name = "integer"
+
+    def convert(self, value: Any, param: Any, ctx: Any) -> Any:
+        number = click.INT.convert(value, param, ctx)
+        try:
+            check_workers(number)
+        except ValueError as error:
+            self.fail(str(error), param, ctx)
+        return number
+
+
+def workers_limit_help() -> str:
+    """The limit of every --workers option, as a sentence of its help."""
+    return f"At most {WORKERS_PER_CORE} per core ({max_workers()} here)."
+
+
+def workers_option(help: str) -> Callable[[Any], Any]:
+    """``--workers``: worker processes (:class:`WorkerCount`), default None; ``help`` says what
+    they run and the default, the limit's sentence follows."""
+    return click.option(
+        "--workers", type=WorkerCount(), default=None, help=f"{help} {workers_limit_help()}"
+    )
 
 
 def seed_option(help: str) -> Callable[[Any], Any]:
@@ -237,12 +286,7 @@ def parallel_options(what: str) -> Callable[[Any], Any]:
     """The --workers, --backend and --scheduler options of commands that run batches of
     independent simulations (``what``: rollouts, examples, ...) on local processes or Dask."""
     options = (
-        click.option(
-            "--workers",
-            type=click.IntRange(1, 1024),
-            default=None,
-            help="Worker processes (default: all cores; 1 runs in this process).",
-        ),
+        workers_option("Worker processes (default: all cores; 1 runs in this process)."),
         click.option(
             "--backend",
             type=click.Choice(BACKENDS),

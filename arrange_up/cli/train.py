@@ -31,10 +31,11 @@ from arrange_up.cli.shared import (
     parallel_options,
     quiet_option,
     seed_option,
+    stopped_early,
     terminal_progress,
 )
 from arrange_up.model.problem import Controller, ControllerKind
-from arrange_up.parallel import BackendUnavailableError
+from arrange_up.parallel import BackendUnavailableError, WorkersLostError
 
 _STAGE_LABELS = {"data": "examples", "test data": "test examples", "fit": "fitting"}
 _TRAIN_COLUMNS = (
@@ -230,6 +231,8 @@ def train_cbst(
             "interrupted; finished examples are kept in the data file: run again to resume",
             EXIT_NEGATIVE,
         )
+    except WorkersLostError as error:
+        stopped_early(error, "; finished examples are kept in the data file: run again to resume")
     except (ValueError, BackendUnavailableError) as err:
         fail(str(err))
     if as_json:
@@ -321,6 +324,8 @@ def rescore_cbst(
             "interrupted; finished examples are kept in the data files: run again to resume",
             EXIT_NEGATIVE,
         )
+    except WorkersLostError as error:
+        stopped_early(error, "; finished examples are kept in the data files: run again to resume")
     except (LookupError, ValueError, BackendUnavailableError) as err:
         fail(str(err))
     if as_json:

@@ -44,7 +44,7 @@ from arrange_up.model.problem import (
     Uncertainty,
 )
 from arrange_up.model.world import ActionNoise, Push, WorldState, draw_noise
-from arrange_up.parallel import local_executor
+from arrange_up.parallel import check_workers, local_executor
 from arrange_up.physics.settings import SERVO_VALUES
 from arrange_up.physics.simulation import (
     DEFAULT_SETTINGS,
@@ -160,6 +160,8 @@ def bench_physics(
         raise ValueError("n_pushes must be at least 1")
     if not workers or any(w < 1 for w in workers):
         raise ValueError("workers must be a non-empty tuple of counts >= 1")
+    for count in workers:  # all refused before the first measurement, not after it
+        check_workers(count)
     rows: list[dict] = []
     rng = np.random.default_rng(seed)
     scenes = []

@@ -37,7 +37,7 @@ import numpy as np
 
 from arrange_up.belief.compiled import CompiledProblem
 from arrange_up.counts import check_count
-from arrange_up.evaluation.evaluate import evaluate_plan
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS, evaluate_plan
 from arrange_up.evaluation.reliability import wilson_interval
 from arrange_up.evaluation.rollouts import rollout_start
 from arrange_up.model.world import Action, WorldState
@@ -119,10 +119,11 @@ def check_validate(validate: Any, start: Any = None) -> None:
     """``ValueError`` unless ``validate`` suits a planning run (from a ``start`` belief when one
     is given): None (the default), or a non-negative integer that is positive only when
     planning from the problem's initial belief (the validation rollouts start from that belief,
-    not from a posterior). Every semantics' plan can be checked."""
+    not from a posterior), at most :data:`~arrange_up.evaluation.evaluate.MAX_ROLLOUTS`. Every
+    semantics' plan can be checked."""
     if validate is None:
         return
-    check_count("validate", validate, minimum=0)
+    check_count("validate", validate, minimum=0, maximum=MAX_ROLLOUTS)
     if validate and start is not None:
         raise ValueError(
             "validate checks plans from the problem's initial belief; a start belief takes none"
