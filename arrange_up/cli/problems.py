@@ -25,6 +25,7 @@ from arrange_up.io.files import text_place
 from arrange_up.io.pddl import PddlExportError, write_pddl_problem
 from arrange_up.io.pddl_reader import problem_name_place
 from arrange_up.io.planfile import write_text_atomic
+from arrange_up.model.errors import printable
 from arrange_up.model.problem import ArrangementProblem
 
 
@@ -66,10 +67,11 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
     for argument in files:
         path, reason = _resolve(argument)
         if path is None:
-            click.echo(f"{argument}: error: {reason}", err=True)
+            click.echo(printable(f"{argument}: error: {reason}"), err=True)
             failed += 1
             continue
-        shown = argument if Path(argument).expanduser().is_file() else str(path)
+        # The file as the user named it, made printable: every line below starts with it.
+        shown = printable(argument if Path(argument).expanduser().is_file() else str(path))
         problem, diagnostics = check_problem_file(path)
         for diagnostic in diagnostics:
             click.echo(str(diagnostic), err=True)
@@ -93,7 +95,7 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
         _warn_stiff(shown, problem)
         if not quiet:
             click.echo(
-                f"{shown}: ok: {problem.name} ({len(problem.parts)} "
+                f"{shown}: ok: {printable(problem.name)} ({len(problem.parts)} "
                 f"part{'s' if len(problem.parts) != 1 else ''}, "
                 f"{'relative' if problem.goal.is_relative else 'absolute'} goal)"
             )
