@@ -13,7 +13,12 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.io import validation
-from arrange_up.io.files import text_place, undecodable_place
+from arrange_up.io.files import (
+    ProblemFileTooLarge,
+    read_problem_bytes,
+    text_place,
+    undecodable_place,
+)
 from arrange_up.io.pddl_domain import (
     ANGLE_FUNCTIONS,
     DOMAIN_FILE,
@@ -83,7 +88,9 @@ def check_pddl_problem(path: str | Path, domain: str | Path | None = None) -> Ch
     bad file."""
     source = str(path)
     try:
-        data = Path(path).read_bytes()
+        data = read_problem_bytes(Path(path))
+    except ProblemFileTooLarge as error:
+        return None, [Diagnostic(source, None, None, "", str(error))]
     except FileNotFoundError:
         return None, [Diagnostic(source, None, None, "", "no such file; expected a .pddl file")]
     except IsADirectoryError:
