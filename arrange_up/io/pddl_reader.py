@@ -34,7 +34,7 @@ from arrange_up.io.pddl_domain import (
     num,
 )
 from arrange_up.io.shape_catalogue import load_catalogue
-from arrange_up.io.validation import Placed
+from arrange_up.io.validation import Placed, too_many_objects
 from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
 from arrange_up.model.problem import (
     ArrangementProblem,
@@ -429,6 +429,10 @@ class _Builder:
 
     # -- the whole problem -----------------------------------------------------------------
     def build(self) -> ArrangementProblem | None:
+        refused = too_many_objects(len(self.up.all_objects))
+        if refused is not None:  # refused before any per-object work
+            self.error("objects", r"\(\s*:objects", refused)
+            return None
         kinds, objects = self.objects()
         values = self.initial_values(kinds)
         if any(d.is_error for d in self.diagnostics):
