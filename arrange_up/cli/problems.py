@@ -93,6 +93,7 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
         names.setdefault(key, path)
         _warn_unfit(shown, problem)
         _warn_stiff(shown, problem)
+        _warn_soft(shown, problem)
         if not quiet:
             click.echo(
                 f"{shown}: ok: {printable(problem.name)} ({len(problem.parts)} "
@@ -134,6 +135,25 @@ def _warn_stiff(shown: str, problem: ArrangementProblem) -> None:
             f"physics' time step (sqrt(kp / m) x dt up to {stiff.rate:.2f}, stable below "
             f"{STABLE_RATE:g}): its pushes oscillate and throw parts; give controller.kp at "
             f"most {stiff.kp_max:.3g}, or kind: servo",
+            err=True,
+        )
+
+
+def _warn_soft(shown: str, problem: ArrangementProblem) -> None:
+    """Warn of each part the compliant controller is too soft for
+    (:func:`arrange_up.physics.stall.soft_parts`): the file is valid, but every push of the part
+    stalls further short than a push on the table can make up for (densities in grams where
+    the gains expect kilograms)."""
+    from arrange_up.physics.stall import soft_parts
+
+    for soft in soft_parts(problem):
+        click.echo(
+            f"{shown}: warning: controller: the compliant controller (kp "
+            f"{problem.controller.kp:g}) is too soft for part {soft.name!r}: a push of it "
+            f"stalls {soft.stall:.3g} in short of its set point (friction x g x density x area "
+            f"/ kp), more than the table's {soft.reach:g} in, so no push gets it where the plan "
+            f"says; check the density unit (per-area mass in the gains' unit), give "
+            f"controller.kp above {soft.kp_min:.3g}, or kind: servo",
             err=True,
         )
 
