@@ -25,6 +25,7 @@ from arrange_up.io.files import text_place
 from arrange_up.io.pddl import PddlExportError, write_pddl_problem
 from arrange_up.io.pddl_reader import problem_name_place
 from arrange_up.io.planfile import write_text_atomic
+from arrange_up.model.errors import printable
 from arrange_up.model.problem import ArrangementProblem
 
 
@@ -66,10 +67,11 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
     for argument in files:
         path, reason = _resolve(argument)
         if path is None:
-            click.echo(f"{argument}: error: {reason}", err=True)
+            click.echo(printable(f"{argument}: error: {reason}"), err=True)
             failed += 1
             continue
-        shown = argument if Path(argument).expanduser().is_file() else str(path)
+        # The file as the user named it, made printable: every line below starts with it.
+        shown = printable(argument if Path(argument).expanduser().is_file() else str(path))
         problem, diagnostics = check_problem_file(path)
         for diagnostic in diagnostics:
             click.echo(str(diagnostic), err=True)
@@ -91,9 +93,10 @@ def check(files: tuple[str, ...], quiet: bool) -> None:
         names.setdefault(key, path)
         _warn_unfit(shown, problem)
         _warn_stiff(shown, problem)
+        _warn_soft(shown, problem)
         if not quiet:
             click.echo(
-                f"{shown}: ok: {problem.name} ({len(problem.parts)} "
+                f"{shown}: ok: {printable(problem.name)} ({len(problem.parts)} "
                 f"part{'s' if len(problem.parts) != 1 else ''}, "
                 f"{'relative' if problem.goal.is_relative else 'absolute'} goal)"
             )
@@ -132,6 +135,25 @@ def _warn_stiff(shown: str, problem: ArrangementProblem) -> None:
             f"physics' time step (sqrt(kp / m) x dt up to {stiff.rate:.2f}, stable below "
             f"{STABLE_RATE:g}): its pushes oscillate and throw parts; give controller.kp at "
             f"most {stiff.kp_max:.3g}, or kind: servo",
+            err=True,
+        )
+
+
+def _warn_soft(shown: str, problem: ArrangementProblem) -> None:
+    """Warn of each part the compliant controller is too soft for
+    (:func:`arrange_up.physics.stall.soft_parts`): the file is valid, but every push of the part
+    stalls further short than a push on the table can make up for (densities in grams where
+    the gains expect kilograms)."""
+    from arrange_up.physics.stall import soft_parts
+
+    for soft in soft_parts(problem):
+        click.echo(
+            f"{shown}: warning: controller: the compliant controller (kp "
+            f"{problem.controller.kp:g}) is too soft for part {soft.name!r}: a push of it "
+            f"stalls {soft.stall:.3g} in short of its set point (friction x g x density x area "
+            f"/ kp), more than the table's {soft.reach:g} in, so no push gets it where the plan "
+            f"says; check the density unit (per-area mass in the gains' unit), give "
+            f"controller.kp above {soft.kp_min:.3g}, or kind: servo",
             err=True,
         )
 

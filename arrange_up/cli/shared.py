@@ -33,7 +33,7 @@ from rich.progress import Progress, ProgressColumn, TaskID
 from arrange_up.evaluation.rollouts import LANDINGS
 from arrange_up.io.domains import UnknownDomainError, load_checked
 from arrange_up.io.planfile import PlanFileError, action_to_json, plan_problem_mismatches, read_plan
-from arrange_up.model.errors import ProblemFormatError
+from arrange_up.model.errors import ProblemFormatError, printable
 from arrange_up.model.problem import ArrangementProblem
 from arrange_up.model.world import Action
 from arrange_up.parallel import BACKENDS, WORKERS_PER_CORE, check_workers, max_workers
@@ -44,8 +44,10 @@ EXIT_BAD_INPUT = 2
 
 
 def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
-    """Print ``arrange-up: message`` on stderr and exit with ``code`` (default: bad input)."""
-    click.echo(f"arrange-up: {message}", err=True)
+    """Print ``arrange-up: message`` on stderr and exit with ``code`` (default: bad input).
+    Control characters in ``message`` (from a file name or a name in a file) are shown escaped
+    (:func:`arrange_up.model.errors.printable`), never sent to the terminal raw."""
+    click.echo(f"arrange-up: {printable(message, keep_newlines=True)}", err=True)
     sys.exit(code)
 
 

@@ -13,7 +13,12 @@ from pathlib import Path
 from typing import Any
 
 from arrange_up.io import validation
-from arrange_up.io.files import text_place, undecodable_place
+from arrange_up.io.files import (
+    ProblemFileTooLarge,
+    read_problem_bytes,
+    text_place,
+    undecodable_place,
+)
 from arrange_up.io.pddl_domain import (
     ANGLE_FUNCTIONS,
     DOMAIN_FILE,
@@ -29,7 +34,7 @@ from arrange_up.io.pddl_domain import (
     num,
 )
 from arrange_up.io.shape_catalogue import load_catalogue
-from arrange_up.io.validation import Placed
+from arrange_up.io.validation import Placed, too_many_objects
 from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
 from arrange_up.model.problem import (
     ArrangementProblem,
@@ -83,7 +88,9 @@ def check_pddl_problem(path: str | Path, domain: str | Path | None = None) -> Ch
     bad file."""
     source = str(path)
     try:
-        data = Path(path).read_bytes()
+        data = read_problem_bytes(Path(path))
+    except ProblemFileTooLarge as error:
+        return None, [Diagnostic(source, None, None, "", str(error))]
     except FileNotFoundError:
         return None, [Diagnostic(source, None, None, "", "no such file; expected a .pddl file")]
     except IsADirectoryError:
@@ -422,6 +429,10 @@ class _Builder:
 
     # -- the whole problem -----------------------------------------------------------------
     def build(self) -> ArrangementProblem | None:
+        refused = too_many_objects(len(self.up.all_objects))
+        if refused is not None:  # refused before any per-object work
+            self.error("objects", r"\(\s*:objects", refused)
+            return None
         kinds, objects = self.objects()
         values = self.initial_values(kinds)
         if any(d.is_error for d in self.diagnostics):

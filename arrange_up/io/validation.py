@@ -74,10 +74,27 @@ MAX_FRICTION = 10.0
 #: says that there are more beyond them (a thousand objects stacked at one pose make half a
 #: million pairs, which are neither worth computing nor reading).
 MAX_LISTED_OVERLAPS = 100
+#: Most objects (parts, manipulators, fixtures and obstacles together) a problem may declare.
+#: A real tabletop problem has 10-20 parts; sampling the initial particles tests every pair of
+#: footprints, so the work grows with the square of the count, and does not look at the
+#: planner's timeout: 10,000 parts kept ``plan --timeout`` waiting far past it. A count beyond
+#: this is refused when the file is read.
+MAX_OBJECTS = 200
 #: Draws :func:`unsampleable` makes: the particle sampler gives up on a particle after as many.
 SAMPLE_DRAWS = 1000
 
 Bounds = tuple[float, float, float, float]
+
+
+def too_many_objects(count: int) -> str | None:
+    """The message refusing a problem that declares ``count`` objects, or ``None`` when that
+    is at most :data:`MAX_OBJECTS`; shared by the YAML and PDDL readers."""
+    if count <= MAX_OBJECTS:
+        return None
+    return (
+        f"the problem declares {count} objects; expected at most {MAX_OBJECTS} (parts, "
+        "manipulators, fixtures and obstacles together; a tabletop problem has tens)"
+    )
 
 
 @dataclass(frozen=True)

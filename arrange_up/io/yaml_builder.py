@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass
 
 from arrange_up.io import validation
-from arrange_up.io.validation import MAX_LISTED_OVERLAPS, Placed
+from arrange_up.io.validation import MAX_LISTED_OVERLAPS, Placed, too_many_objects
 from arrange_up.io.yaml_settings import (
     SettingsReader,
 )
@@ -109,6 +109,8 @@ class ProblemBuilder(NodeReader):
         self.shape_reader.units = self.settings_reader.units = self.units
         shapes = self.shape_reader.shapes(root)
         objects = self.objects(root, shapes)
+        if objects is None:  # too many to check: the rest would be a flood of messages
+            return None
         initial = self.initial(root, objects)
         self.check_placement(table, objects, initial)
         goal = self.goal(root, objects)
@@ -310,7 +312,10 @@ class ProblemBuilder(NodeReader):
         return tuple(e for e in WALL_EDGES if e in chosen) if ok else None
 
     # -- objects --------------------------------------------------------------------------------
-    def objects(self, root: Node, shapes: dict[str, Shape | None]) -> dict[str, _Object]:
+    def objects(self, root: Node, shapes: dict[str, Shape | None]) -> dict[str, _Object] | None:
+        """The declared objects by name (an invalid one kept, marked not ok, so that its uses
+        are not reported as undeclared); ``None`` after an error when the file declares more
+        than :data:`~arrange_up.io.validation.MAX_OBJECTS`, before any of them is read."""
         objects: dict[str, _Object] = {}
         node = self.required(
             root, "objects", "a mapping from object names to {kind: ..., shape: ...}"
@@ -324,6 +329,10 @@ class ProblemBuilder(NodeReader):
                 f"expected a mapping from object names to {{kind: ..., shape: ...}}, got {got}",
             )
             return objects
+        refused = too_many_objects(len(node.value))
+        if refused is not None:
+            self.error(node, refused)
+            return None
         for key_node, value_node in node.entries():
             name = key_node.value
             if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):

@@ -25,7 +25,12 @@ from ruamel.yaml.reader import ReaderError
 from ruamel.yaml.scalarbool import ScalarBoolean
 
 from arrange_up.io import yaml_tree
-from arrange_up.io.files import text_place, undecodable_place
+from arrange_up.io.files import (
+    ProblemFileTooLarge,
+    read_problem_bytes,
+    text_place,
+    undecodable_place,
+)
 from arrange_up.io.validation import angle_problem
 from arrange_up.io.yaml_tree import YamlMap, join
 from arrange_up.model.errors import Diagnostic
@@ -58,7 +63,9 @@ def read_text(path: Path, source: str) -> tuple[str | None, Diagnostic | None]:
         return Diagnostic(source, line, column, "", message)
 
     try:
-        data = path.read_bytes()
+        data = read_problem_bytes(path)
+    except ProblemFileTooLarge as error:
+        return None, fail(str(error))
     except FileNotFoundError:
         return None, fail("no such file; expected a .yaml problem file")
     except IsADirectoryError:

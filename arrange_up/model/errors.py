@@ -15,11 +15,34 @@ diagnostic found in the file (errors and warnings), so a user fixes a file in on
 
 from __future__ import annotations
 
+import unicodedata
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Literal
 
 Severity = Literal["error", "warning"]
+
+
+def printable(text: str, *, keep_newlines: bool = False) -> str:
+    """``text`` with every control or format character (ANSI escapes, a bidi override, a NUL)
+    written as Python writes it in a string literal (``\\x1b``, ``\\u202e``), every other
+    character unchanged: a name from a file, echoed in a message, cannot then recolour or
+    rewrite the user's terminal, and an ordinary name reads exactly as written. With
+    ``keep_newlines`` a newline stays a line break (a message of several lines)."""
+    if text.isprintable():  # the usual case: nothing to escape, no per-character work
+        return text
+    return "".join(
+        char
+        if (char == "\n" and keep_newlines)
+        or unicodedata.category(char) not in _UNPRINTABLE_CATEGORIES
+        else repr(char)[1:-1]
+        for char in text
+    )
+
+
+# Control (C0, DEL, C1) and format characters (bidi overrides, zero-width ones): the ones a
+# terminal acts on or that hide what a name really is. Spaces and letters of any script stay.
+_UNPRINTABLE_CATEGORIES = frozenset({"Cc", "Cf"})
 
 
 @dataclass(frozen=True)
@@ -45,13 +68,16 @@ class Diagnostic:
         return self.severity == "error"
 
     def __str__(self) -> str:
-        where = self.file
+        # Every part may hold text from the user's file (a key path holds key names, a
+        # message quotes them): all are made printable here, the one place diagnostics are
+        # turned into text.
+        where = printable(self.file)
         if self.line is not None:
             where += f":{self.line}"
             if self.column is not None:
                 where += f":{self.column}"
-        path = f"{self.path}: " if self.path else ""
-        return f"{where}: {self.severity}: {path}{self.message}"
+        path = f"{printable(self.path)}: " if self.path else ""
+        return f"{where}: {self.severity}: {path}{printable(self.message, keep_newlines=True)}"
 
 
 def sort_diagnostics(diagnostics: Iterable[Diagnostic]) -> list[Diagnostic]:

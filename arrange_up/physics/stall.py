@@ -30,6 +30,8 @@ the planner offers (the planner gives CBST these pushes: ``compressed_wall_pushe
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from arrange_up.model.problem import (
     STANDARD_GRAVITY,
     ArrangementProblem,
@@ -37,7 +39,15 @@ from arrange_up.model.problem import (
     ControllerKind,
 )
 
-__all__ = ["WALL_MARGIN", "stall_per_area", "stall_spread", "wall_overdrive", "wall_push_front"]
+__all__ = [
+    "SoftPart",
+    "WALL_MARGIN",
+    "soft_parts",
+    "stall_per_area",
+    "stall_spread",
+    "wall_overdrive",
+    "wall_push_front",
+]
 
 #: Inches the set point of a compliant push to a wall goes beyond the worst-case stall and the
 #: paddle's pose uncertainty: the contact slop and what the PD still lags when it settles.
@@ -54,6 +64,40 @@ def stall_per_area(problem: ArrangementProblem) -> float:
     friction = 0.5 * (u.friction[0] + u.friction[1])
     density = 0.5 * (u.part_density[0] + u.part_density[1])
     return friction * STANDARD_GRAVITY * density / controller.kp
+
+
+class SoftPart(NamedTuple):
+    """A part the compliant controller is too soft for (:func:`soft_parts`)."""
+
+    name: str
+    stall: float
+    """Inches a nominal push of the part alone stops short of its set point."""
+    reach: float
+    """The table's shorter side (in): the most a push's set point can be moved on to make up
+    for the stall."""
+    kp_min: float
+    """The smallest ``kp`` whose stall for this part is ``reach``."""
+
+
+def soft_parts(problem: ArrangementProblem) -> list[SoftPart]:
+    """The parts the problem's compliant controller is too soft for: those whose nominal stall
+    (:func:`stall_per_area` times the part's area: a push of the part alone, at mid-range
+    friction and density) is longer than the table's shorter side. The push generators add
+    the stall to every push's travel, so a stall of an inch or two is planned for (the shipped
+    problems stall up to 1.8 in on a 12 in table), but a set point that must go a table's length
+    beyond the part is off the table: no push gets the part where the plan says (a file with
+    densities in grams per cm², a thousand times the kilogram ones, stalls about 57 in on that
+    table). Empty under the servo, which does not stall."""
+    per_area = stall_per_area(problem)
+    if per_area <= 0.0:
+        return []
+    reach = min(problem.table.width, problem.table.depth)
+    found = []
+    for part in problem.parts:
+        stall = per_area * part.shape.area
+        if stall > reach:
+            found.append(SoftPart(part.name, stall, reach, problem.controller.kp * stall / reach))
+    return found
 
 
 def stall_spread(problem: ArrangementProblem) -> float:
