@@ -40,6 +40,20 @@ def test_a_relative_pair_plans_once_its_reference_has_moved_from_the_edge():
     assert isinstance(result.actions[0], Push)  # A makes room before B is placed
 
 
+def test_a_mate_blocked_by_its_references_shadow_alone_is_placed_on_a_ring():
+    # Two cubes squared flush in the open (issue 32, gap b): at 50 particles A's shadow covers
+    # every place of B's grid, and pushing A about moves the grid with it; B goes one ring out.
+    problem = load_problem(FRESH / "open-pair-off.yaml")
+    result = arrange_up.plan(problem, particles=50, workers=1, validate=0)
+    assert result.solved, result.reason
+    first, second = result.actions[:2]
+    assert isinstance(first, Place) and first.obj == "A"
+    assert isinstance(second, Place) and second.obj == "B"
+    assert second.pose[0] - first.pose[0] > 1.7  # a ring out, then pushed in
+    final = result.beliefs[-1]
+    assert GoalTest(problem).satisfied_array(final.poses, final.names())
+
+
 def test_a_reference_that_starts_off_the_table_is_put_down_with_room_for_its_mates():
     # Its goal is anywhere; it is placed where the goal arrangement is centred on the table.
     problem = load_problem(FRESH / "reference-off-table.yaml")

@@ -16,7 +16,10 @@ target, out to the table's size. From such a place a push brings the part in. On
 that parts with a clear place nearby keep the shortest pushes. A relative goal's parts get no
 rings: a part must end beside its reference, which may move, and where no place beside it is
 clear the reference is moved first (the reference ladder,
-:mod:`~arrange_up.planning.generators.distances`).
+:mod:`~arrange_up.planning.generators.distances`). But where the reference's own shadow is
+what blocks every place of a mate's grid (each would be clear without it: a goal flush against
+the reference, whose shadow is wider than the grid's step), moving the reference moves the grid
+with it, so the mate gets the rings up to :data:`FULL_RINGS` (:meth:`PlaceGenerator._mate_rings`).
 
 The precondition is tested on belief shadows (:mod:`arrange_up.geometry.collision`): the
 placed part's shadow (target +- place uncertainty) must lie on the table and touch no shadow of
@@ -90,6 +93,17 @@ class PlaceGenerator:
             spec.name: () if ringless else rings(self.offsets[spec.name], max(problem.table.size))
             for spec in problem.parts
         }
+        #: A relative goal's mates: the rings up to :data:`FULL_RINGS`, tried only where the
+        #: reference's own shadow is what blocks every place of the grid (:meth:`_mate_rings`).
+        self.reference = problem.goal.reference
+        self.mate_rings = {
+            spec.name: rings(self.offsets[spec.name], max(problem.table.size))[: FULL_RINGS - 1]
+            for spec in problem.parts
+            if self.reference is not None
+            and not hints.place_offsets
+            and spec.name in problem.goal.parts
+            and spec.name != self.reference
+        }
 
     def _grid(self, spec: ObjectSpec) -> tuple[tuple[float, float], ...]:
         nominal = self.checker.shadow_box(spec.name, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
@@ -119,7 +133,41 @@ class PlaceGenerator:
                         break
                 if len(actions) > found:
                     break
+            else:
+                actions.extend(self._mate_rings(spec.name, targets, on_table))
         return actions
+
+    def _mate_rings(self, name: str, targets, on_table) -> list[Place]:
+        """Places of a relative goal's mate ``name`` on the rings about its target (nearest
+        ring with a clear place first), where no place of its grid is clear but some would be
+        without the reference on the table: its goal is flush against the reference, whose
+        shadow covers the grid (two cubes squared in the open: the grid's step clears the
+        part's own shadow, not the reference's). Moving the reference (its ladder) moves the
+        grid with it, so only a place farther out, and a push in, can bring the part there."""
+        offsets_rings = self.mate_rings.get(name)
+        if not offsets_rings:
+            return []
+        others = [shadow for shadow in on_table if shadow[0] != self.reference]
+        if len(others) == len(on_table):
+            return []
+        other_boxes = [self.checker.shadow_box(*shadow) for shadow in others]
+        if not any(
+            self._place_ok(name, pose, self.place_unc, others, other_boxes)
+            for target in targets
+            for pose in self._place_grid(target, self.offsets[name])
+        ):
+            return []  # not the reference's doing: the ladder may still help
+        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+        for offsets in offsets_rings:
+            found = [
+                Place(name, clean_pose(pose))
+                for target in targets
+                for pose in self._place_grid(target, offsets)
+                if self._place_ok(name, pose, self.place_unc, on_table, boxes)
+            ]
+            if found:
+                return found
+        return []
 
     def place_poses(self, belief: IntervalBelief, name: str) -> list[Pose]:
         """Candidate place poses of ``name`` that fit the table, walls and obstacles, whatever
