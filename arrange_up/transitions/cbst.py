@@ -127,7 +127,7 @@ TRAINED_PUSH_TOLERANCE = 1e-3
 #: the 99th percentile, rounded up to 0.01 in, of how far generated grazes moved the grazed
 #: block beyond its box across the push (2000 scenes, seed 0; seed 1 as a fresh check), where
 #: the grazer's overlap, a bound only for a corner sliding straight past, was several times as
-#: wide (docs/cbst.md, "How far the predictions hold": `python benchmarks/cbst_graze.py
+#: wide (docs/cbst-models.md, "How far the predictions hold": `python benchmarks/cbst_graze.py
 #: scenes`). Like PREDICT's boxes, an allowance measured in simulation, not a bound: a plan is
 #: checked on rollouts (:mod:`arrange_up.planning.validation`).
 GRAZE_ALLOWANCE: dict[ControllerKind, float] = {
