@@ -16,6 +16,7 @@ from typing import Any
 import pytest
 
 from arrange_up.io import yaml_tree
+from arrange_up.io.validation import MAX_OBJECTS
 from arrange_up.io.yaml_problem import check_problem_text
 from arrange_up.io.yaml_source import Report, parse
 from arrange_up.io.yaml_tree import Document, Refused, Unsupported, YamlMap, YamlSeq
@@ -365,21 +366,21 @@ def test_an_unsupported_yaml_version_is_an_error_not_a_crash() -> None:
 def test_big_files_using_each_feature_are_read_by_libyaml(
     monkeypatch: pytest.MonkeyPatch, feature: str
 ) -> None:
-    """A 100 kB problem using the feature on every line is read without ruamel (whose reading
-    of it takes seconds: ``benchmarks/big_inputs.py --files``) and checks; a small one reads as
-    ruamel reads it."""
+    """A problem of the most objects allowed (:data:`MAX_OBJECTS`, 14-40 kB) using the feature
+    on every line is read without ruamel (whose reading of big files takes seconds:
+    ``benchmarks/big_inputs.py --files``) and checks; a small one reads as ruamel reads it."""
     small = featured(30, feature)
     if feature != "tabs":  # ruamel refuses a tab after a colon in block context
         assert_same_document(yaml_tree.read(small), yaml_tree.read_ruamel(small))
-    text = featured(1000, feature)
-    assert len(text) > 60_000
+    text = featured(MAX_OBJECTS, feature)
+    assert len(text) > 14_000
 
     def refuse(text: str) -> None:
         raise AssertionError("read by ruamel")
 
     monkeypatch.setattr(yaml_tree, "read_ruamel", refuse)
     problem, found = check_problem_text(text, "big.yaml")
-    assert problem is not None and len(problem.objects) == 1000, found
+    assert problem is not None and len(problem.objects) == MAX_OBJECTS, found
 
 
 # ---------------------------------------------------------------------------------------------
