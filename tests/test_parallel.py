@@ -153,6 +153,14 @@ def _alive(pid: int) -> bool:
         return True
 
 
+def _alive_after(pids: list[int], seconds: float) -> list[int]:
+    """The processes of ``pids`` still running once all have ended or ``seconds`` passed."""
+    deadline = time.monotonic() + seconds
+    while any(_alive(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return [pid for pid in pids if _alive(pid)]
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="orphans keep their parent pid on Windows")
 def test_workers_end_when_their_parent_is_killed():
     # a SIGKILLed parent cannot stop its pool; its workers lived on for tens of seconds
@@ -174,10 +182,7 @@ def test_workers_end_when_their_parent_is_killed():
     finally:
         parent.send_signal(signal.SIGKILL)
         parent.wait()
-    deadline = time.monotonic() + 5.0
-    while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert not any(_alive(pid) for pid in workers)
+    assert not _alive_after(workers, 5.0)
 
 
 _ORPHANS_AT_START = """
@@ -216,10 +221,7 @@ def test_workers_end_when_their_parent_is_killed_while_they_start():
     finally:
         parent.send_signal(signal.SIGKILL)
         parent.wait()
-    deadline = time.monotonic() + 10.0
-    while any(_alive(pid) for pid in children) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    left = [pid for pid in children if _alive(pid)]
+    left = _alive_after(children, 10.0)
     for pid in left:  # do not leave them behind when the test fails
         os.kill(pid, signal.SIGKILL)
     assert not left

@@ -88,21 +88,20 @@ class PlaceGenerator:
         }
         #: Part name -> the offsets of each ring (none for a relative goal, and none where the
         #: problem gives ``planning.place_offsets``: those replace the grid whole).
-        ringless = bool(hints.place_offsets) or problem.goal.is_relative
-        self.rings = {
-            spec.name: () if ringless else rings(self.offsets[spec.name], max(problem.table.size))
+        every = {
+            spec.name: ()
+            if hints.place_offsets
+            else rings(self.offsets[spec.name], max(problem.table.size))
             for spec in problem.parts
         }
+        self.rings = {name: () if problem.goal.is_relative else r for name, r in every.items()}
         #: A relative goal's mates: the rings up to :data:`FULL_RINGS`, tried only where the
         #: reference's own shadow is what blocks every place of the grid (:meth:`_mate_rings`).
         self.reference = problem.goal.reference
         self.mate_rings = {
-            spec.name: rings(self.offsets[spec.name], max(problem.table.size))[: FULL_RINGS - 1]
-            for spec in problem.parts
-            if self.reference is not None
-            and not hints.place_offsets
-            and spec.name in problem.goal.parts
-            and spec.name != self.reference
+            name: r[: FULL_RINGS - 1]
+            for name, r in every.items()
+            if self.reference is not None and name in problem.goal.parts and name != self.reference
         }
 
     def _grid(self, spec: ObjectSpec) -> tuple[tuple[float, float], ...]:
@@ -134,30 +133,33 @@ class PlaceGenerator:
                 if len(actions) > found:
                     break
             else:
-                actions.extend(self._mate_rings(spec.name, targets, on_table))
+                actions.extend(self._mate_rings(spec.name, targets, on_table, boxes))
         return actions
 
-    def _mate_rings(self, name: str, targets, on_table) -> list[Place]:
+    def _mate_rings(self, name: str, targets, on_table, boxes) -> list[Place]:
         """Places of a relative goal's mate ``name`` on the rings about its target (nearest
         ring with a clear place first), where no place of its grid is clear but some would be
         without the reference on the table: its goal is flush against the reference, whose
         shadow covers the grid (two cubes squared in the open: the grid's step clears the
         part's own shadow, not the reference's). Moving the reference (its ladder) moves the
-        grid with it, so only a place farther out, and a push in, can bring the part there."""
+        grid with it, so only a place farther out, and a push in, can bring the part there.
+        ``boxes`` are the shadow boxes of ``on_table`` (None when :meth:`places` built none)."""
         offsets_rings = self.mate_rings.get(name)
         if not offsets_rings:
             return []
-        others = [shadow for shadow in on_table if shadow[0] != self.reference]
-        if len(others) == len(on_table):
+        kept = [k for k, shadow in enumerate(on_table) if shadow[0] != self.reference]
+        if len(kept) == len(on_table):
             return []
-        other_boxes = [self.checker.shadow_box(*shadow) for shadow in others]
+        if boxes is None:  # the grid tested no pose (``places`` builds them lazily)
+            boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
+        others = [on_table[k] for k in kept]
+        other_boxes = [boxes[k] for k in kept]
         if not any(
             self._place_ok(name, pose, self.place_unc, others, other_boxes)
             for target in targets
             for pose in self._place_grid(target, self.offsets[name])
         ):
             return []  # not the reference's doing: the ladder may still help
-        boxes = [self.checker.shadow_box(*shadow) for shadow in on_table]
         for offsets in offsets_rings:
             found = [
                 Place(name, clean_pose(pose))
