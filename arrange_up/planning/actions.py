@@ -47,7 +47,9 @@ from arrange_up.planning.obstacles import Obstacles
 class ActionGenerator:
     """Proposes the candidate actions of a belief (see the module docstring).
 
-    The keyword options are :class:`~arrange_up.planning.generators.common.PushOptions`'."""
+    The keyword options are :class:`~arrange_up.planning.generators.common.PushOptions`', and
+    ``place_rings``: offer places on rings farther out where a part's place grid has none clear
+    (:mod:`~arrange_up.planning.generators.places`)."""
 
     def __init__(
         self,
@@ -59,6 +61,7 @@ class ActionGenerator:
         compressed_wall_pushes: bool = False,
         solve_distances: bool = True,
         clearance_pushes: bool = True,
+        place_rings: bool = True,
     ) -> None:
         self.problem = problem
         self.checker = checker
@@ -92,7 +95,9 @@ class ActionGenerator:
             mating=mating,
             detours=detours,
         )
-        self.place_generator = PlaceGenerator(problem, checker, self.targets)
+        self.place_generator = PlaceGenerator(
+            problem, checker, self.targets, with_rings=place_rings
+        )
         self.push_generator = PushGenerator(
             problem,
             checker,

@@ -97,6 +97,7 @@ class BeliefTask:
                 compressed_wall_pushes=not model.simulates_pushes,
                 solve_distances=model.simulates_pushes,
                 clearance_pushes=model.particles > 1,
+                place_rings=model.place_rings,
             )
             estimate = make_heuristic(
                 search.heuristic, compiled, generator, ordering_filter=search.ordering_filter

@@ -49,6 +49,12 @@ class Semantics(Protocol):
         planner does not propose it. False for a learned prediction (CBST), which is a function
         of the belief (a repeat is a duplicate) and which needs such pushes to narrow intervals
         until later contacts are certain. A class that subclasses this protocol inherits True.
+    place_rings
+        True when the planner may place a part on rings farther out where its place grid has
+        none clear, a push then bringing it in (:mod:`arrange_up.planning.generators.places`).
+        False for CBST with a simulated fallback: its boxes, rebuilt from a few simulations,
+        do not hold the spread of the longer pushes a ring's place needs (docs/cbst.md). A
+        class that subclasses this protocol inherits True.
 
     A semantics may also say why it refused transitions: ``reasons``, a
     :class:`collections.Counter` of short human-readable sentences, one count per ``None``
@@ -65,6 +71,7 @@ class Semantics(Protocol):
     simulations: int
     refuses_uncertain_contacts: bool = False
     simulates_pushes: bool = True
+    place_rings: bool = True
 
     def initial_belief(self) -> Any: ...
 

@@ -200,6 +200,8 @@ class CBSTSemantics:
             if fallback_particles
             else None
         )
+        #: No place rings where the fallback answers (see transitions.Semantics).
+        self.place_rings = self.fallback is None
         #: Push transitions asked for, and those the simulated fallback answered.
         self.pushes = 0
         self.fallbacks = 0

@@ -155,6 +155,7 @@ class ParticleSemantics:
     name = "particles"
     refuses_uncertain_contacts = False  # it predicts every push (see transitions.Semantics)
     simulates_pushes = True
+    place_rings = True
 
     def __init__(
         self, problem: ArrangementProblem, *, particles: int = 50, seed: int = 0, workers: int = 1

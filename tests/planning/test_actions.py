@@ -134,6 +134,8 @@ def test_a_part_with_no_clear_place_on_the_grid_is_offered_the_nearest_clear_rin
         (FRESH / "bracket-clearance.yaml").read_text() + "planning: {place_offsets: [[0, 0]]}\n"
     )
     assert generator(hinted).places(IntervalBelief(())) == []
+    # And a semantics that turns the rings off gets the grid's places only: none here.
+    assert generator(problem, place_rings=False).places(IntervalBelief(())) == []
 
 
 def test_place_hints_replace_the_grid_and_add_angles():

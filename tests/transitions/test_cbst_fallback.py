@@ -33,6 +33,7 @@ def compliant():
 def test_a_push_the_model_refuses_falls_back_to_the_physics(compliant):
     sem = CBSTSemantics(compliant)
     assert sem.fallback is not None
+    assert not sem.place_rings  # its boxes would not hold a ring's longer pushes
     belief = sem.apply(sem.initial_belief(), Place("A", (5.0, 2.5, 0.0)))
     out = sem.apply(belief, _short_push((5.0, 2.5)))
     assert out is not None
@@ -81,6 +82,7 @@ def test_the_servo_model_has_no_fallback(compliant):
     servo = dataclasses.replace(compliant, controller=Controller(kind=ControllerKind.SERVO))
     sem = CBSTSemantics(servo)
     assert sem.fallback is None and sem.fallback_counts() is None
+    assert sem.place_rings
     belief = sem.apply(sem.initial_belief(), Place("A", (5.0, 2.5, 0.0)))
     assert sem.apply(belief, _short_push((5.0, 2.5))) is None
     assert plan(servo, semantics="cbst", validate=0).fallbacks is None

@@ -73,8 +73,15 @@ class PlaceGenerator:
     """The place candidates of the parts off the table (see the module docstring)."""
 
     def __init__(
-        self, problem: ArrangementProblem, checker: CollisionChecker, targets: GoalTargets
+        self,
+        problem: ArrangementProblem,
+        checker: CollisionChecker,
+        targets: GoalTargets,
+        *,
+        with_rings: bool = True,
     ) -> None:
+        """``with_rings=False`` offers the grid's places only: no part (no mate of a relative
+        goal either) gets rings."""
         self.problem = problem
         self.checker = checker
         self.targets = targets
@@ -86,11 +93,12 @@ class PlaceGenerator:
             spec.name: tuple(hints.place_offsets) if hints.place_offsets else self._grid(spec)
             for spec in problem.parts
         }
-        #: Part name -> the offsets of each ring (none for a relative goal, and none where the
-        #: problem gives ``planning.place_offsets``: those replace the grid whole).
+        #: Part name -> the offsets of each ring (none for a relative goal, none where the
+        #: problem gives ``planning.place_offsets``, which replace the grid whole, and none
+        #: where the caller asks for no rings).
         every = {
             spec.name: ()
-            if hints.place_offsets
+            if hints.place_offsets or not with_rings
             else rings(self.offsets[spec.name], max(problem.table.size))
             for spec in problem.parts
         }
