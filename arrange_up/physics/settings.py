@@ -29,7 +29,7 @@ class PhysicsSettings:
     ``None``: a push takes its controller's values (:meth:`for_controller`,
     :data:`CONTROLLER_VALUES`); a value given explicitly holds for both controllers. Every
     default is argued in :mod:`arrange_up.physics.simulation` or measured in
-    ``docs/design/physics.md``.
+    ``docs/design/physics.md`` and ``docs/design/physics-controller.md``.
     """
 
     dt: float = 1.0 / 240.0
@@ -114,7 +114,8 @@ class PhysicsSettings:
     compliant_in_solver: bool = False
     """Run the compliant controller inside the engine's solver (springs and dampers on a
     set-point body, :mod:`arrange_up.physics.simulation`) rather than as a force set from
-    Python before every step. The choice and its measurements: ``docs/design/physics.md``."""
+    Python before every step. The choice and its measurements:
+    ``docs/design/physics-controller.md``."""
 
     def __post_init__(self) -> None:
         positive = (
