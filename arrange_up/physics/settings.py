@@ -226,9 +226,9 @@ COMPLIANT_VALUES: dict[str, float | int] = {
 a check every 3 steps (0.0125 s) with the old speed threshold (1.25e-4 in per check is the old
 1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep; a push
 not at rest 1 s after its set point's end is solved at 20 iterations from then on, and its
-drive ends once the paddle has made no progress along the push for 0.5 s. About
-0.7x the steps and 0.55-0.6x the time of the servo's values, final poses as close to the
-reference."""
+drive ends once the paddle has made no progress along the push for 0.5 s. Fewer steps and
+less time than the servo's values, final poses as close to the reference (the figures:
+``docs/design/physics.md``, "Settling and rest per controller")."""
 
 CONTROLLER_VALUES: dict[ControllerKind, dict[str, float | int]] = {
     ControllerKind.SERVO: SERVO_VALUES,
