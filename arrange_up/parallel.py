@@ -157,7 +157,7 @@ def available_cores() -> int:
 
 #: Worker processes allowed per core this process may use (:func:`max_workers`). The work is
 #: simulation, bound by the CPU: beyond one process per core more only compete for the cores
-#: and for memory (every worker imports numpy, shapely and pymunk, about 100 MB), and a
+#: and for memory (every worker imports numpy, shapely and pymunk), and a
 #: mistyped count (``--workers 1024``) would start hundreds of processes. Four per core leave
 #: room for overlapping start-up and I/O.
 WORKERS_PER_CORE = 4
@@ -339,7 +339,8 @@ def _end_with_parent(parent: int) -> None:
     if os.getppid() != parent:
         # Killed while this worker started (loky starts workers as its direct children, and
         # the initializer runs only after the worker's imports, a second or more): the parent
-        # is gone already and nothing would end this orphan (it lived 40-50 s). A parent
+        # is gone already and nothing would end this orphan (docs/design/cli.md, "Orphans at
+        # start-up"). A parent
         # that still exists started it through an intermediate process: nothing to watch.
         if not _exists(parent):
             os._exit(1)

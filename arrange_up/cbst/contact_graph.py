@@ -86,9 +86,9 @@ __all__ = [
 ]
 
 #: Smallest overlap (inches) of two blocks' spans across the push that makes their contact
-#: *certain*: the front one is then squarely in the way. In data generated with 0.25 in,
-#: trains whose weakest contact overlapped by 0.25-0.35 in buckled (a block squeezed out
-#: sideways) in 6 % of the examples, 0.35-0.5 in in 2 %, above 0.5 in never (210 examples).
+#: *certain*: the front one is then squarely in the way. Trains whose weakest contact overlaps
+#: by less buckle (a block squeezes out sideways) more often, the less it overlaps (the
+#: figures: docs/cbst.md, "Training data").
 MIN_OVERLAP = 0.4
 #: The same for the paddle's contact with the first object of a train (inches): the wide,
 #: rigid paddle does not buckle, it only has to be sure to hit the object.

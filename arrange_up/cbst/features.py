@@ -42,10 +42,11 @@ Targets (4 numbers): three are the thesis's definitions over K rollouts ``i``:
   the predicted half-width about the centre angle 0.
 * ``slip = max(0, max_i u_i - x_max)`` (inches): **our addition**, not in the thesis. A train
   pushed off-centre can buckle: blocks squeeze out sideways and one may end beyond ``x_max``
-  (we measured up to 1.8 in), which the thesis's three targets cannot express. The semantics
-  declines to predict when the predicted slip exceeds :data:`BUCKLE_LIMIT`, and otherwise
-  widens the interval's upper end to ``x_max + max(slip, allowance)``, the allowance being
-  the contact slop of the physics measured in the data (model card).
+  (how far, and how often: ``docs/cbst.md``, "PREDICT"), which the thesis's three targets
+  cannot express, and a prediction that ignored it would claim a box the train has left. The
+  semantics declines to predict when the predicted slip exceeds :data:`BUCKLE_LIMIT`, and
+  otherwise widens the interval's upper end to ``x_max + max(slip, allowance)``, the allowance
+  being the contact slop of the physics measured in the data (model card).
 
 With ``GenerationSettings.quantile`` ``q`` below 1 (:mod:`.data`), every maximum over the
 rollouts above is their ``q`` quantile instead (``dx``: of ``x_max - u_i``), so that a target

@@ -141,8 +141,8 @@ def load_model(
     return _load_cached(str(card_path), stat.st_mtime_ns, stat.st_size)
 
 
-#: The largest arrays file loading reads, and the largest array in it once unpacked (the
-#: shipped model: 0.23 MB packed): a model file can never exhaust memory.
+#: The largest arrays file loading reads, and the largest array in it once unpacked (256 MiB,
+#: far above any shipped model's): a model file can never exhaust memory.
 MAX_ARRAYS_BYTES = 1 << 28
 MAX_ARRAY_BYTES = 1 << 28
 #: The arrays of a stored :class:`FastForest`, and the dtype kind each must have.

@@ -24,10 +24,11 @@ from arrange_up import __version__
 __all__ = ["main"]
 
 # The only lazy imports of the CLI. A command group's module imports the library at module level
-# (numpy, shapely, pymunk, matplotlib, rich, ...): importing every one of them took 1.1 s, against
-# 42 ms for this module (`python -c pass`: 10 ms; measured, see docs/design/cli.md). So the group
-# imports a command's module only when that command runs, and lists the commands with the short
-# help written here (tests/cli/test_lazy_group.py checks it against each command's own).
+# (numpy, shapely, pymunk, matplotlib, rich, ...), which costs many times what this module does
+# (the figures and the command that measures them: docs/design/cli.md, "Start-up: one lazy
+# place"). So the group imports a command's module only when that command runs, and lists the
+# commands with the short help written here (tests/cli/test_lazy_group.py checks it against
+# each command's own).
 #: command name -> (module in arrange_up.cli, attribute, short help)
 COMMANDS: dict[str, tuple[str, str, str]] = {
     "bench": (

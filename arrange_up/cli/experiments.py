@@ -590,8 +590,11 @@ def experiment_fixtures(
           --rollouts 100 --output-dir tz-quick
       arrange-up experiment fixtures --plans 5 --particles 10,40,150 --workers 1 \\
           --controller servo --no-ablation --output-dir docs/results/servo
-                                       # docs/results.md's servo rows: ~32 min on 2 cores
-      arrange-up experiment fixtures --workers 1   # thesis scale: ~2-3 h on 2 cores (est.)
+                                       # docs/results.md's servo rows
+      arrange-up experiment fixtures --workers 1   # thesis scale
+
+    Before it starts, the sweep prints how many measurements it will make and about how long
+    they take (estimated from measured runs).
 
     Exit status: 0 the sweep ran (whatever the results), 1 interrupted, 2 bad input or a CSV
     measured on other nominal plans.

@@ -63,8 +63,8 @@ __all__ = ["MAX_ROLLOUTS", "evaluate_plan"]
 
 #: The most rollouts one evaluation runs. The to-do is lazy, but every finished rollout's
 #: record is kept until the breakdown is counted (a failed one holds about 2 KB), and the
-#: Wilson interval of a million rollouts is already within ±0.1 %: a larger count is a typo
-#: (``--rollouts 99999999999999999999`` built a 6 GB list before the limit), not a wish.
+#: Wilson interval of a million rollouts is already within ±0.1 %: a larger count is a typo,
+#: not a wish (docs/design/cli.md, "Rollout counts").
 MAX_ROLLOUTS = 1_000_000
 
 

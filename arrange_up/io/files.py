@@ -33,8 +33,7 @@ __all__ = [
 R = TypeVar("R")
 
 #: The largest problem file (YAML or PDDL) read, in bytes: 1 MiB. A real problem is a few
-#: kilobytes (the biggest shipped one is under 4 KB); the parsers need about 40 bytes of
-#: memory and 3 microseconds per byte (a 50 MB file took 145 s and 1.9 GB), so a file
+#: kilobytes; the parsers' time and memory grow with the file (docs/design/io.md), so a file
 #: hundreds of times bigger than any real problem is refused before it is parsed.
 MAX_PROBLEM_BYTES = 1024 * 1024
 

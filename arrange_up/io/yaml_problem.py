@@ -1,6 +1,8 @@
 """Load and validate ``.yaml`` problem files (format ``arrange-up/1``).
 
-The format is specified in ``docs/problem-format.md``. This module turns a file into an
+The format is specified in ``docs/problem-format.md`` (arrange-up's own ``planning:`` and
+``controller:`` keys in ``docs/problem-format-planner.md``, every check and message in
+``docs/problem-format-checks.md``). This module turns a file into an
 :class:`~arrange_up.model.problem.ArrangementProblem` or refuses it with a
 :class:`~arrange_up.model.errors.ProblemFormatError` that lists *every* problem found in the file,
 each naming the file, the 1-based line and column where the offending YAML node starts, the key

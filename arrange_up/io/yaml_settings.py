@@ -1,6 +1,7 @@
 """The ``uncertainty:``, ``planning:`` and ``controller:`` sections of a YAML problem: the
 noise of actions and of the world, the action generator's hints, and the push controller
-(``docs/problem-format.md``)."""
+(``docs/problem-format.md``; ``planning:`` and ``controller:`` in
+``docs/problem-format-planner.md``)."""
 
 from __future__ import annotations
 
@@ -170,8 +171,8 @@ class SettingsReader(NodeReader):
 
     # -- the push controller --------------------------------------------------------------------
     def controller(self, root: Node) -> Controller | None:
-        """The ``controller:`` mapping (``docs/problem-format.md``), converted to internal units
-        by :func:`controller_factors`."""
+        """The ``controller:`` mapping (``docs/problem-format-planner.md``), converted to internal
+        units by :func:`controller_factors`."""
         if not root.has("controller"):
             return DEFAULT_CONTROLLER
         node = root.child("controller")

@@ -247,7 +247,8 @@ class Controller:
 
 DEFAULT_CONTROLLER = Controller()
 """The controller of a problem that names none (and of every PDDL problem): the compliant one
-at its documented defaults (the measurements that chose them are in docs/design/physics.md)."""
+at its documented defaults (the measurements that chose them are in
+docs/design/physics-controller.md)."""
 
 SERVO_CONTROLLER = Controller(kind=ControllerKind.SERVO)
 """The servo at its defaults: the controller of every problem before problems named one (and

@@ -29,7 +29,7 @@ class PhysicsSettings:
     ``None``: a push takes its controller's values (:meth:`for_controller`,
     :data:`CONTROLLER_VALUES`); a value given explicitly holds for both controllers. Every
     default is argued in :mod:`arrange_up.physics.simulation` or measured in
-    ``docs/design/physics.md``.
+    ``docs/design/physics.md`` and ``docs/design/physics-controller.md``.
     """
 
     dt: float = 1.0 / 240.0
@@ -114,7 +114,8 @@ class PhysicsSettings:
     compliant_in_solver: bool = False
     """Run the compliant controller inside the engine's solver (springs and dampers on a
     set-point body, :mod:`arrange_up.physics.simulation`) rather than as a force set from
-    Python before every step. The choice and its measurements: ``docs/design/physics.md``."""
+    Python before every step. The choice and its measurements:
+    ``docs/design/physics-controller.md``."""
 
     def __post_init__(self) -> None:
         positive = (
@@ -225,9 +226,9 @@ COMPLIANT_VALUES: dict[str, float | int] = {
 a check every 3 steps (0.0125 s) with the old speed threshold (1.25e-4 in per check is the old
 1e-3 in per 0.1 s, 0.01 in/s), 5 solver iterations, and bodies idle for 0.05 s asleep; a push
 not at rest 1 s after its set point's end is solved at 20 iterations from then on, and its
-drive ends once the paddle has made no progress along the push for 0.5 s. About
-0.7x the steps and 0.55-0.6x the time of the servo's values, final poses as close to the
-reference."""
+drive ends once the paddle has made no progress along the push for 0.5 s. Fewer steps and
+less time than the servo's values, final poses as close to the reference (the figures:
+``docs/design/physics.md``, "Settling and rest per controller")."""
 
 CONTROLLER_VALUES: dict[ControllerKind, dict[str, float | int]] = {
     ControllerKind.SERVO: SERVO_VALUES,

@@ -86,8 +86,8 @@ semi-implicit Euler step of ``F = clip(Kd (clamp(Kp/Kd (ref - x), v_max) - v))``
 i.e. the thesis's clipped PD with ``Kd = sqrt(4 m Kp)`` when ``damping_ratio = 1`` (the
 default), written in the usual cascade form so that the speed limit caps the desired velocity.
 The gains grow as ``1 / dt`` and ``1 / dt**2``: a stiff position servo, as a robot arm is (their
-values at the default step: ``docs/design/physics.md``, "The push controller"). With these gains
-the velocity loop is dead-beat in discrete time and the position error then shrinks by
+values at the default step: ``docs/design/physics-controller.md``, "The servo's gains"). With
+these gains the velocity loop is dead-beat in discrete time and the position error then shrinks by
 ``1 - rate dt = 3/4`` per step: no overshoot, no oscillation.
 
 *Where it differs from a fixed-gain PD:* in contact, the joint is solved together with the
@@ -103,7 +103,7 @@ a chain of 7 blocks at the highest friction and density of the thesis's ranges a
 against a wall instead of crushing through it. A problem of heavier parts raises the clip to 1.5
 times the friction of all its parts at its nominal (mid-range) friction and density
 (:func:`push_force`); its heaviest draws can still stall the push, as the thesis's low-gain
-controller stalled. The figures behind both: ``docs/design/physics.md``.
+controller stalled. The figures behind both: ``docs/design/physics-controller.md``.
 
 The compliant controller
 ========================
@@ -119,7 +119,7 @@ where the set point ``x_ref(t)`` moves from the approach pose along the push lin
 and stops ``distance`` along it: the thesis's real robot fed its low-gain controller
 intermediate set points along the pushing line, updated with time (§2.4.2). A PD toward the
 distant end point with no speed limit would be a catapult (it throws blocks:
-``docs/design/physics.md``). The paddle has its own moment here (a compliant
+``docs/design/physics-controller.md``). The paddle has its own moment here (a compliant
 wrist turns when a part meets it off-centre) and still no table friction. The drive runs until
 the set point has stopped and the paddle has been still (position and angle) for
 ``rest_checks`` checks; then the robot holds the paddle (a pivot and a gear joint with no bias,
@@ -127,9 +127,9 @@ clipped at ``force`` and ``torque``: the brake) until the other bodies are at re
 low gain a resisted push stops short by about the resisting friction / Kp, growing with friction
 x mass; a free push ends at its target without overshoot (semi-implicit Euler of a critically
 damped PD with ``sqrt(Kp / m) dt`` well below 1). Defaults (``Kp = 300``) and their measurements:
-``docs/design/physics.md``. With ``PhysicsSettings.compliant_in_solver`` the same PD, set point
-and clips are built from constraints the engine solves (:class:`_SolverTracking`), not set from
-Python before every step.
+``docs/design/physics-controller.md``. With ``PhysicsSettings.compliant_in_solver`` the same PD,
+set point and clips are built from constraints the engine solves (:class:`_SolverTracking`), not
+set from Python before every step.
 
 Rest
 ====
@@ -166,7 +166,8 @@ squeezed by the solver, and at the default rate its slow re-expansion against th
 the paddle creeping for most of a second.
 
 The defaults' accuracy (against a finer step) and every other figure behind them are in
-``docs/design/physics.md``, with the commands that reproduce them.
+``docs/design/physics.md`` (the controllers' in ``docs/design/physics-controller.md``), with
+the commands that reproduce them.
 
 Determinism and speed
 =====================
@@ -826,7 +827,7 @@ def _lag_matched_damping(kd: float, inertia: float, dt: float) -> float:
     tracking a set point moving at constant speed the explicit PD's lag, ``Kd v / Kp``: the
     engine damps implicitly (velocity times ``exp(-c dt / m)`` per step), which at the same
     ``Kd`` lags by ``1 + Kd dt / 2m`` times more; ``c = m / dt * log(1 + Kd dt / m)`` (chosen
-    on ``benchmarks/push_accuracy.py``, ``docs/design/physics.md``)."""
+    on ``benchmarks/push_accuracy.py``, ``docs/design/physics-controller.md``)."""
     return inertia / dt * math.log1p(kd * dt / inertia)
 
 
@@ -1185,7 +1186,7 @@ def compliant_gains(
 
 
 #: The largest ``sqrt(K / m) * dt`` (and ``sqrt(K_angle / I) * dt``) at which the compliant
-#: controller's explicitly integrated PD follows its set point (docs/problem-format.md,
+#: controller's explicitly integrated PD follows its set point (docs/problem-format-planner.md,
 #: ``controller:``); beyond it the simulated paddle oscillates and parts are thrown.
 STABLE_RATE = 0.5
 
