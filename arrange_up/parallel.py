@@ -96,6 +96,7 @@ __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
     "WorkersLostError",
+    "local_workers_lost",
     "DaskRunner",
     "LocalRunner",
     "Pending",
@@ -132,7 +133,9 @@ class WorkersLostError(RuntimeError):
     that recorded them (an evaluation's record file) keeps them, and says how to go on."""
 
 
-def _local_workers_lost(error: BaseException) -> WorkersLostError:
+def local_workers_lost(error: BaseException) -> WorkersLostError:
+    """The one-line :class:`WorkersLostError` for a broken local pool ``error`` (loky's
+    ``TerminatedWorkerError`` or another ``BrokenProcessPool``)."""
     return WorkersLostError(
         "a local worker process ended abruptly (killed, or out of memory), which broke the "
         f"process pool ({type(error).__name__})"
@@ -418,7 +421,7 @@ class LocalRunner(Runner):
                     try:
                         pairs = future.result()
                     except BrokenProcessPool as error:  # loky's TerminatedWorkerError too
-                        raise _local_workers_lost(error) from error
+                        raise local_workers_lost(error) from error
                     following = next(chunks, None)
                     if following is not None:
                         submit(following)
@@ -488,7 +491,7 @@ class _LocalPending(Pending[R]):
             except BrokenProcessPool as error:  # a worker died (killed, out of memory): the pool is
                 self.attempts += 1  # rebuilt by the next local_executor call
                 if self.attempts > RETRIES:
-                    raise _local_workers_lost(error) from error
+                    raise local_workers_lost(error) from error
                 self._retry(with_context=True)
                 continue
             if isinstance(value, _ContextMissing):

@@ -41,6 +41,7 @@ import hashlib
 from collections import Counter
 from collections.abc import Sequence
 from concurrent.futures import Executor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -66,7 +67,7 @@ from arrange_up.model.world import (
     nominal_initial_state,
     nominal_noise,
 )
-from arrange_up.parallel import local_executor
+from arrange_up.parallel import local_executor, local_workers_lost
 from arrange_up.physics.simulation import DEFAULT_SETTINGS, SimulationStatus, simulate
 
 #: Extra reach of a push beyond its commanded distance, and sideways drift allowance (inches).
@@ -324,7 +325,8 @@ class ParticleSemantics:
         with ``workers > 1`` and more than one share in the batch, the shares run on the
         process's worker pool, else here. With ``stop_on_failure`` a share stops at its first
         failure (the group's outcome is a failure anyway). The outcomes do not depend on
-        ``workers``.
+        ``workers``. A pool whose worker ended abruptly raises
+        :class:`~arrange_up.parallel.WorkersLostError`, one line, not loky's error.
         """
         tasks: list[tuple[int, range]] = []
         for g, jobs in enumerate(groups):
@@ -333,9 +335,14 @@ class ParticleSemantics:
         chunks = [[groups[g][i] for i in indices] for g, indices in tasks]
         if self.workers > 1 and len(tasks) > 1:
             n = len(chunks)
-            results = list(
-                self._pool().map(_simulate_chunk, [self.problem] * n, chunks, [stop_on_failure] * n)
-            )
+            try:
+                results = list(
+                    self._pool().map(
+                        _simulate_chunk, [self.problem] * n, chunks, [stop_on_failure] * n
+                    )
+                )
+            except BrokenProcessPool as error:  # loky's TerminatedWorkerError too
+                raise local_workers_lost(error) from error
         else:
             results = [_simulate_chunk(self.problem, chunk, stop_on_failure) for chunk in chunks]
         outcomes: list[list[Simulated | None]] = [[None] * len(jobs) for jobs in groups]

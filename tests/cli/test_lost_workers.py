@@ -1,9 +1,10 @@
-"""A batch whose workers are lost (a loky worker killed during ``evaluate --workers 2``, a Dask
-scheduler gone) ends in one line, exit 1, that says what was kept and the command that resumes;
-never a traceback."""
+"""A batch whose workers are lost (a loky worker killed during ``evaluate --workers 2`` or
+``repair --workers 2``, a Dask scheduler gone) ends in one line, exit 1, that says what was kept
+and the command that resumes; never a traceback."""
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import signal
@@ -15,6 +16,7 @@ from arrange_up import parallel
 from arrange_up.cli import main
 from arrange_up.evaluation import evaluate as evaluation
 from arrange_up.evaluation.rollouts import rollout_task
+from arrange_up.transitions import particles
 
 DOOMED = 6  # the rollout whose worker is killed
 
@@ -52,6 +54,31 @@ def test_a_killed_local_worker_ends_evaluate_in_one_line_that_says_how_to_resume
     assert again.exit_code == 0, again.output
     assert "of 12 rollouts" in again.output
     assert (f"{len(recorded)} resumed" in again.output) == bool(recorded)
+
+
+SIMULATE_CHUNK = particles._simulate_chunk
+
+
+def _killing_chunk(problem, jobs, stop_on_failure, *, parent):
+    """A share of the particle semantics' pushes whose worker dies (SIGKILL); simulated as
+    usual when it runs in the ``parent`` process (a batch of one share)."""
+    if os.getpid() != parent:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return SIMULATE_CHUNK(problem, jobs, stop_on_failure)
+
+
+def test_a_killed_worker_of_the_particle_semantics_ends_repair_in_one_line(monkeypatch):
+    # the fixture repair simulates on the particle semantics' own pool, not a runner's
+    killing = functools.partial(_killing_chunk, parent=os.getpid())
+    monkeypatch.setattr(particles, "_simulate_chunk", killing)
+    args = ["repair", "blocks-2", "--particles", "4", "--workers", "2", "--quiet"]
+    lost = CliRunner().invoke(main, args)
+    assert lost.exit_code == 1, lost.output
+    assert lost.exception is None or isinstance(lost.exception, SystemExit)
+    lines = lost.output.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in lost.output, lost.output
+    assert lines[0].startswith("arrange-up: a local worker process ended abruptly")
+    assert "no plan was written" in lines[0]
 
 
 def test_a_lost_dask_batch_is_one_line_not_distributed_s_error():
