@@ -54,8 +54,8 @@ SCALED_DOWN: dict[str, str] = {
         "arrange-up experiment transition-comparison --problems blocks-4 --particles 5"
         " --runs 1 --rollouts 5"
     ),
-    "arrange-up experiment search-table": (
-        "arrange-up experiment search-table --problems blocks-1"
+    "arrange-up experiment search-table --timeout 60": (
+        "arrange-up experiment search-table --timeout 60 --problems blocks-1"
     ),
     "arrange-up experiment fixtures --plans 5 --particles 10,40,150": (
         "arrange-up experiment fixtures --problems down-push --plans 1 --particles 10 --rollouts 5"
