@@ -245,9 +245,9 @@ def test_a_fixture_put_down_must_be_picked_up_before_the_goal_is_reached(corner)
 
 
 # Successes of 40 rollouts (seed 0) the plans must reach, well below what they score (25 and
-# 40; the plans of the generator without fences score 23 and 29; the 200-rollout rates are in
-# docs/design/planning-fences.md). The deterministic plan's approach poses ignore the initial
-# spread, so some of its pushes start overlapping the block.
+# 40; the plans of the generator without fences score 23 and 29; the 200-rollout rates measured
+# as the fences were added are in docs/history/planning.md). The deterministic plan's approach
+# poses ignore the initial spread, so some of its pushes start overlapping the block.
 FLOORS = {"deterministic": 15, "particles": 32}
 
 
