@@ -154,5 +154,6 @@ class GoalTest:
             )
         return tuple(PartMiss(p, True, (0.0, 0.0, 0.0)) for p in missing) + left + judged
 
+
 def _as_array(state: WorldState) -> np.ndarray:
     return np.array([[pose for _, pose in state.poses]], dtype=float).reshape(1, -1, 3)

@@ -215,9 +215,7 @@ def test_a_mate_blocked_by_the_reference_and_a_placed_mate_is_placed_on_a_ring()
     both = belief(R=((6.0, 4.0, 0.0), SMALL), A=((6.0, 5.0, 0.0), SMALL))
     step = max(abs(dx) for dx, _ in gen.place_generator.offsets["B"])
     far = gen.places(both, only="B")
-    assert far and all(
-        max(abs(p.pose[0] - 7.0), abs(p.pose[1] - 5.0)) > step + 1e-9 for p in far
-    )
+    assert far and all(max(abs(p.pose[0] - 7.0), abs(p.pose[1] - 5.0)) > step + 1e-9 for p in far)
 
 
 def test_place_candidates_for_relative_goal_follow_reference():
