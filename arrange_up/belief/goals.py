@@ -79,7 +79,14 @@ class GoalTest:
         index = {name: i for i, name in enumerate(names)}
         if any(p not in index for p in self.parts):
             return None
-        coords = poses[:, [index[p] for p in self.parts], :].copy()
+        return self._coordinates(poses, index, list(range(len(self.parts))))
+
+    def _coordinates(
+        self, poses: np.ndarray, index: dict[str, int], which: list[int]
+    ) -> np.ndarray | None:
+        """:meth:`coordinates` of the goal parts ``which`` (indices into ``parts``), each of
+        them among ``index``; None when the goal's reference is not."""
+        coords = poses[:, [index[self.parts[k]] for k in which], :].copy()
         if self.reference is not None:
             if self.reference not in index:
                 return None
@@ -89,12 +96,10 @@ class GoalTest:
             coords[..., 0] = c * dx + s * dy
             coords[..., 1] = -s * dx + c * dy
             coords[..., 2] = coords[..., 2] - ref[..., 2]
-        half = 0.5 * self.periods
-        coords[..., 2] = (
-            self.targets[:, 2]
-            + ((coords[..., 2] - self.targets[:, 2] + half) % self.periods)
-            - half
-        )
+        targets = self.targets[which]
+        periods = self.periods[which]
+        half = 0.5 * periods
+        coords[..., 2] = targets[:, 2] + ((coords[..., 2] - targets[:, 2] + half) % periods) - half
         return coords
 
     def excess(self, poses: np.ndarray, names: Sequence[str]) -> np.ndarray | None:
@@ -121,26 +126,33 @@ class GoalTest:
         return self.misses_array(_as_array(state), state.names())
 
     def misses_array(self, poses: np.ndarray, names: Sequence[str]) -> tuple[PartMiss, ...]:
-        """Why the particles ``poses`` (``(P, n, 3)``) fail the goal, part by part: a part's
-        excess in a dimension is the largest over the particles (empty when all satisfy it)."""
-        missing = [p for p in self.parts if p not in names]
-        if self.reference is not None and self.reference not in names:
+        """Why the particles ``poses`` (``(P, n, 3)``) fail the goal, part by part: the goal
+        parts (and reference) not on the table, the fixtures to put away still on it, then the
+        goal parts on the table that miss their goal, a part's excess in a dimension the
+        largest over the particles (empty when all satisfy it). A part on the table is judged
+        even while others are off it; a relative goal's mates only while its reference is on
+        the table."""
+        index = {name: i for i, name in enumerate(names)}
+        missing = [p for p in self.parts if p not in index]
+        if self.reference is not None and self.reference not in index:
             missing.append(self.reference)
-        if missing:
-            return tuple(PartMiss(p, True, (0.0, 0.0, 0.0)) for p in missing)
-        excess = self.excess(poses, names)
-        assert excess is not None
-        worst = excess.max(axis=0)
         left = tuple(
             PartMiss(name, False, (0.0, 0.0, 0.0), left=True)
             for name in names
             if name in self.put_away
         )
-        return left + tuple(
-            PartMiss(part, False, as_triple(float(v) for v in worst[i]))
-            for i, part in enumerate(self.parts)
-            if np.any(worst[i] > 0.0)
-        )
+        which = [k for k, p in enumerate(self.parts) if p in index]
+        coords = self._coordinates(poses, index, which) if which else None
+        judged: tuple[PartMiss, ...] = ()
+        if coords is not None:
+            beyond = np.maximum(np.abs(coords - self.targets[which]) - self.tolerance - EPS, 0.0)
+            worst = beyond.max(axis=0)
+            judged = tuple(
+                PartMiss(self.parts[k], False, as_triple(float(v) for v in worst[i]))
+                for i, k in enumerate(which)
+                if np.any(worst[i] > 0.0)
+            )
+        return tuple(PartMiss(p, True, (0.0, 0.0, 0.0)) for p in missing) + left + judged
 
 
 def _as_array(state: WorldState) -> np.ndarray:

@@ -57,6 +57,24 @@ def test_absolute_goal_accepts_symmetric_turn_and_rejects_excess():
     assert [m.dimensions() for m in goal.misses(missing)] == [("off table",)]
 
 
+def test_a_part_on_the_table_that_misses_is_reported_while_another_is_off_it():
+    # The planner's reason line ("the best belief still misses ...") listed only the parts off
+    # the table while any was, as if those on it were at their goals.
+    goal = GoalTest(tiny("two-blocks-row"))
+    astray = WorldState((("A", (9.5, 1.0, 0.0)),))  # B off the table, A 0.5 in too high
+    misses = [(m.part, m.dimensions()) for m in goal.misses(astray)]
+    assert misses == [("B", ("off table",)), ("A", ("y",))]
+    assert goal.misses(astray)[1].excess == pytest.approx((0.0, 0.3, 0.0))
+
+
+def test_a_relative_goals_mates_are_judged_only_with_their_reference_on_the_table():
+    goal = GoalTest(tiny("relative-goal"))
+    alone = WorldState((("U", (3.0, 3.0, 0.0)),))
+    assert [(m.part, m.dimensions()) for m in goal.misses(alone)] == [("T", ("off table",))]
+    far = WorldState((("T", (3.0, 3.0, 0.0)),))
+    assert [(m.part, m.dimensions()) for m in goal.misses(far)] == [("U", ("off table",))]
+
+
 def test_relative_goal_is_invariant_to_moving_the_pair():
     p = tiny("relative-goal")
     goal = GoalTest(p)

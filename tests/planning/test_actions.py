@@ -191,6 +191,35 @@ def test_place_target_of_an_absolute_goal_is_the_goal_pose():
     assert gen.place_target("paddle", IntervalBelief(())) is None
 
 
+# Two cubes side by side on a 3 x 1 bar, wherever the bar ends (issue 32: a relative goal of
+# eleven mates placed five of them, each mate flush against a placed one having no place).
+TWO_MATES = """
+name: two-mates
+table: {size: [12, 8]}
+objects:
+  R: {kind: part, shape: {box: [3, 1]}}
+  A: {kind: part, shape: {box: [1, 1]}}
+  B: {kind: part, shape: {box: [1, 1]}}
+  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}
+initial:
+  R: {pose: [6, 4, 0], uncertainty: [0.1, 0.1, 3]}
+goal:
+  tolerance: [0.2, 0.2, 15]
+  relative: {reference: R, poses: {A: [0, 1, 0], B: [1, 1, 0]}}
+uncertainty: {place: [0.2, 0.2, 15]}
+"""
+
+
+def test_a_mate_blocked_by_the_reference_and_a_placed_mate_is_placed_on_a_ring():
+    gen = generator(load_problem_text(TWO_MATES, "two-mates"))
+    # R and A at their goal, squared: every place of B's grid overlaps A's shadow or R's, and
+    # moving R (its ladder) moves A's target and B's with it, so only a ring helps.
+    both = belief(R=((6.0, 4.0, 0.0), SMALL), A=((6.0, 5.0, 0.0), SMALL))
+    step = max(abs(dx) for dx, _ in gen.place_generator.offsets["B"])
+    far = gen.places(both, only="B")
+    assert far and all(max(abs(p.pose[0] - 7.0), abs(p.pose[1] - 5.0)) > step + 1e-9 for p in far)
+
+
 def test_place_candidates_for_relative_goal_follow_reference():
     p = variant("relative-goal", "  U: {pose: [8, 8, 0], uncertainty: [0.3, 0.3, 5]}\n", "")
     gen = ActionGenerator(p, CollisionChecker(p))

@@ -20,6 +20,8 @@ clear the reference is moved first (the reference ladder,
 what blocks every place of a mate's grid (each would be clear without it: a goal flush against
 the reference, whose shadow is wider than the grid's step), moving the reference moves the grid
 with it, so the mate gets the rings up to :data:`FULL_RINGS` (:meth:`PlaceGenerator._mate_rings`).
+The same holds where the shadows of the reference and of the other mates block it together (a
+mate flush against another mate, as in a row of mates on the reference).
 
 The precondition is tested on belief shadows (:mod:`arrange_up.geometry.collision`): the
 placed part's shadow (target +- place uncertainty) must lie on the table and touch no shadow of
@@ -111,6 +113,10 @@ class PlaceGenerator:
             for name, r in every.items()
             if self.reference is not None and name in problem.goal.parts and name != self.reference
         }
+        #: The parts that move with the grid: the reference and its mates (a mate flush
+        #: against another mate is blocked by that mate's shadow as it would be by the
+        #: reference's).
+        self.arrangement = frozenset(problem.goal.parts) | {self.reference}
 
     def _grid(self, spec: ObjectSpec) -> tuple[tuple[float, float], ...]:
         nominal = self.checker.shadow_box(spec.name, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
@@ -147,15 +153,16 @@ class PlaceGenerator:
     def _mate_rings(self, name: str, targets, on_table, boxes) -> list[Place]:
         """Places of a relative goal's mate ``name`` on the rings about its target (nearest
         ring with a clear place first), where no place of its grid is clear but some would be
-        without the reference on the table: its goal is flush against the reference, whose
-        shadow covers the grid (two cubes squared in the open: the grid's step clears the
-        part's own shadow, not the reference's). Moving the reference (its ladder) moves the
-        grid with it, so only a place farther out, and a push in, can bring the part there.
+        without the reference and the other mates on the table: its goal is flush against
+        them, whose shadows cover the grid (two cubes squared in the open: the grid's step
+        clears the part's own shadow, not the reference's). Moving the reference (its ladder)
+        moves the grid with it, and the mates with the reference, so only a place farther
+        out, and a push in, can bring the part there.
         ``boxes`` are the shadow boxes of ``on_table`` (None when :meth:`places` built none)."""
         offsets_rings = self.mate_rings.get(name)
         if not offsets_rings:
             return []
-        kept = [k for k, shadow in enumerate(on_table) if shadow[0] != self.reference]
+        kept = [k for k, shadow in enumerate(on_table) if shadow[0] not in self.arrangement]
         if len(kept) == len(on_table):
             return []
         if boxes is None:  # the grid tested no pose (``places`` builds them lazily)
