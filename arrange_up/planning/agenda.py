@@ -56,6 +56,7 @@ __all__ = [
     "AgendaRecord",
     "SubSearch",
     "goal_order",
+    "parts_label",
     "plan_by_agenda",
     "restricted",
     "subgoal_budget",
@@ -110,7 +111,7 @@ class AgendaRecord:
             )
         done = sum(len(group) for group in self.subgoals)
         where = (
-            f"the agenda failed at part {done + 1} of {len(self.order)} "
+            f"the agenda failed at {parts_label(done, len(self.failed_at), len(self.order))} "
             f"({'+'.join(self.failed_at)}) after {self.expanded} nodes"
             if self.failed_at
             else f"the agenda stopped at part {done + 1} of {len(self.order)}"
@@ -128,6 +129,14 @@ class AgendaRecord:
             "expanded": self.expanded,
             "failed_at": None if self.failed_at is None else list(self.failed_at),
         }
+
+
+def parts_label(before: int, count: int, total: int) -> str:
+    """The parts a subgoal adds, counted in the agenda's order: ``"part 3 of 13"`` for one
+    part after ``before`` finished ones, ``"parts 1-3 of 13"`` for a group of ``count``."""
+    if count == 1:
+        return f"part {before + 1} of {total}"
+    return f"parts {before + 1}-{before + count} of {total}"
 
 
 def subgoal_budget(max_nodes: int, parts: int) -> int:
@@ -248,7 +257,8 @@ def plan_by_agenda(
     the problem's initial belief); ``max_nodes`` the run's node limit, which the agenda's
     searches share and the full search gets whole; ``timeout`` the seconds for all of them.
     ``progress`` receives each search's statistics with ``stage``: ``"part k of N (P)"``
-    while the agenda adds part P as the k-th of N, ``"full search"`` after it failed.
+    while the agenda adds part P as the k-th of N (``"parts j-k of N (P+Q)"`` for a group,
+    :func:`parts_label`), ``"full search"`` after it failed.
 
     The result's statistics add up every search of the run (``max_nodes`` is the run's limit);
     :attr:`~arrange_up.planning.planner.PlanResult.agenda` records the agenda. When the agenda
@@ -279,7 +289,7 @@ def plan_by_agenda(
         if nodes <= 0:
             break
         belief = done[-1][1].beliefs[-1] if done else start  # type: ignore[index]  # solved
-        stage = f"part {position + size} of {len(order)} ({'+'.join(group)})"
+        stage = f"{parts_label(position, size, len(order))} ({'+'.join(group)})"
         result = search(
             restricted(problem, order[: position + size]), belief, nodes, left(), staged(stage)
         )

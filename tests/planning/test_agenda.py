@@ -52,9 +52,17 @@ def test_a_failed_subgoal_is_searched_again_with_its_predecessor(monkeypatch):
     # B first walls A out of the corner: A alone cannot follow, so B is searched again
     # together with A, from the start.
     monkeypatch.setattr(agenda, "goal_order", lambda problem: ("B", "A"))
-    result = plan(load("blocks-2"), semantics="deterministic")
+    stages = []
+    result = plan(load("blocks-2"), semantics="deterministic", progress=stages.append)
     assert result.solved and result.agenda.solved_by == "agenda"
     assert result.agenda.subgoals == (("B", "A"),)
+    # the progress counts a group's parts as the result line does: from the first it adds
+    assert [s["stage"] for s in stages if "+" in s["stage"]][-1] == "parts 1-2 of 2 (B+A)"
+
+
+def test_the_parts_a_subgoal_adds_are_labelled_from_its_first():
+    assert agenda.parts_label(2, 1, 13) == "part 3 of 13"
+    assert agenda.parts_label(0, 3, 13) == "parts 1-3 of 13"
 
 
 def test_where_the_agenda_fails_the_full_search_plans(monkeypatch):
