@@ -8,7 +8,7 @@ unified-planning 1.3.0) and asks each engine: ``arrange-up`` to solve (``particl
 and ``arrange-up-fixtures`` to repair it (2 particles); an example without a plan gets an empty
 ``SequentialPlan``. Prints, per engine, how many answers had each status and how many raised,
 and lists the exceptions. It uses only what every version of the engines accepts, so it runs
-on older commits too (the figures before and after issue 14 in ``docs/design/up.md``).
+on older commits too (the figures before issue 14 in ``docs/history/up.md``).
 ``tests/up/test_answers.py`` asserts the outcome: a status from every engine, never an
 exception.
 """
