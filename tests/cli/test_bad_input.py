@@ -111,6 +111,7 @@ YAML_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "nan-pose": (_yaml("pose: [2, 2, 0]", "pose: [.nan, 2, 0]"), ("finite",)),
     "inf-tolerance": (_yaml("[0.2, 0.2, 15]", "[.inf, 0.2, 15]"), ("finite",)),
     "zero-table": (_yaml("size: [10, 5]", "size: [0, 5]"), ("> 0",)),
+    "box-area-rounds-to-zero": (_yaml("box: [1, 1]", "box: [1e-300, 1e-300]"), ("degenerate",)),
     "negative-friction": (_yaml("friction: [0.25", "friction: [-0.25"), (">= 0",)),
     "duplicate-key": (GOOD_YAML + "name: two\n", ("duplicate",)),
     "name-is-a-list": (_yaml("name: one", "name: [1, 2]"), ("name",)),
