@@ -249,6 +249,26 @@ class _Text:
         match = re.search(pattern, self.code, flags=re.IGNORECASE)
         return self.position(match.start()) if match else (None, None)
 
+    def assigned_again(self) -> list[tuple[str, int, int]]:
+        """Each numeric fluent ``:init`` sets a second time (whatever its case), as written
+        there, with the line and column of the second ``(=``. A reader keeps one of the values
+        and drops the other without a word, so the file is ambiguous."""
+        start = re.search(r"\(\s*:init\b", self.code, flags=re.IGNORECASE)
+        if start is None:
+            return []
+        end = re.compile(r"\(\s*:(goal|metric|constraints)\b", flags=re.IGNORECASE)
+        stop = end.search(self.code, start.end())
+        section = self.code[start.end() : stop.start() if stop else len(self.code)]
+        seen: set[str] = set()
+        again = []
+        for match in re.finditer(r"\(\s*=\s*(\([^()]*\))", section):
+            fluent = match.group(1)
+            key = " ".join(fluent.strip("()").lower().split())
+            if key in seen:
+                again.append((fluent, *self.position(start.end() + match.start())))
+            seen.add(key)
+        return again
+
     def declared_again(self, name: str) -> tuple[int | None, int | None]:
         """Where ``:objects`` declares ``name`` (whatever its case) a second time, or, declared
         once (named like a type of the domain), where it does so."""
@@ -435,6 +455,7 @@ class _Builder:
             return None
         kinds, objects = self.objects()
         values = self.initial_values(kinds)
+        self.assigned_once()
         if any(d.is_error for d in self.diagnostics):
             return None  # numbers that are not doubles would fail every later check
         table = self.table(values)
@@ -527,6 +548,22 @@ class _Builder:
                     "written -15 or (- 15))",
                 )
         return out
+
+    def assigned_once(self) -> None:
+        """Refuse a numeric fluent that ``:init`` sets twice (the reader would keep one value)."""
+        if self.located is None:
+            return
+        for fluent, line, column in self.located.assigned_again():
+            self.diagnostics.append(
+                Diagnostic(
+                    self.source,
+                    line,
+                    column,
+                    f"init.{fluent.strip('()').split()[0]}",
+                    f"{' '.join(fluent.split())} is set a second time; expected each value set "
+                    "once in :init",
+                )
+            )
 
     def finite(self, number: Fraction, path: str, pattern: str) -> bool:
         """Whether ``number`` is a usable double; reported at ``pattern`` when it is not."""

@@ -192,6 +192,10 @@ PDDL_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "unknown-type": (_pddl("A - block-1x1", "A - gizmo"), ("gizmo",)),
     "no-table": (_pddl("(= (table-width) 10) (= (table-depth) 5)", ""), ("table-width",)),
     "negative-noise": (_pddl("(= (place-dx) 0.2)", "(= (place-dx) -0.2)"), (">= 0",)),
+    "fluent-set-twice": (
+        _pddl("(= (place-dx) 0.2)", "(= (place-dx) 0.2) (= (PLACE-dx) 0.3)"),
+        (":25:", "(place-dx) is set a second time"),
+    ),
     "empty-goal-interval": (_pddl("(<= (x A) 9.7)", "(<= (x A) 9.1)"), ("empty",)),
     "overlapping-start": (
         _pddl(
