@@ -446,6 +446,19 @@ COMMAND_CASES: dict[str, tuple[list[str], tuple[str, ...]]] = {
         [*QUICK_EVALUATE, "--backend", "local", "--scheduler", "tcp://127.0.0.1:1"],
         ("--scheduler",),
     ),
+    # a problem that does not exist: a count not refused would end at once with another message
+    "execute-episodes-huge": (
+        ["execute", "no-such-problem", "--episodes", "99999999999999999999"],
+        ("--episodes", "1000000"),
+    ),
+    "execute-particles-huge": (
+        ["execute", "no-such-problem", "--particles", "99999999999999999999"],
+        ("--particles", "100000"),
+    ),
+    "execute-filter-particles-huge": (
+        ["execute", "no-such-problem", "--filter-particles", "99999999999999999999"],
+        ("--filter-particles", "100000"),
+    ),
     "repair-seed-negative": ([*QUICK_REPAIR, "--seed", "-1"], ("--seed",)),
     "repair-particles-zero": ([*QUICK_REPAIR, "--particles", "0"], ("--particles",)),
     "repair-output-in-a-file": ([*QUICK_REPAIR, "-o", "{tmp}/file/r.json"], ("--output",)),
