@@ -465,6 +465,15 @@ COMMAND_CASES: dict[str, tuple[list[str], tuple[str, ...]]] = {
     "show-svg-as-gif": (["show", "blocks-1", "-o", "{tmp}/b.gif"], ("--output", ".svg")),
     "show-no-suffix": (["show", "blocks-1", "-o", "{tmp}/picture"], ("--output", ".png")),
     "show-output-in-a-file": (["show", "blocks-1", "-o", "{tmp}/file/b.png"], ("--output",)),
+    "show-fps-nan": (
+        ["show", "blocks-1", "--plan", "{plan}", "--animate", "{tmp}/a.gif", "--fps", "nan"],
+        ("--fps", "finite"),
+    ),
+    "train-quantile-nan": ([*QUICK_TRAIN, "--quantile", "nan"], ("--quantile", "finite")),
+    "train-block-half-inf": (
+        [*QUICK_TRAIN, "--block-half", "0.1", "inf", "5"],
+        ("--block-half", "finite"),
+    ),
     "show-seed-negative": (
         ["show", "blocks-1", "--plan", "{plan}", "--seed", "-1", "-o", "{tmp}/s.png"],
         ("--seed",),
