@@ -69,6 +69,10 @@ YAML_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "initial-angle-1e300": (_yaml("pose: [2, 2, 0]", "pose: [2, 2, 1e300]"), ("angle",)),
     "goal-angle-1e300": (_yaml("poses: {A: [5, 2, 0]}", "poses: {A: [5, 2, 1e300]}"), ("angle",)),
     "tolerance-angle-1e300": (_yaml("[0.2, 0.2, 15]", "[0.2, 0.2, 1e300]"), ("angle",)),
+    "initial-dx-1e300": (
+        _yaml("[0.1, 0.1, 5]", "[1e300, 0.1, 5]"),
+        ("initial.A.uncertainty[0]", "at most 1000 in"),
+    ),
     "initial-dtheta-1e300": (_yaml("[0.1, 0.1, 5]", "[0.1, 0.1, 1e300]"), ("angle",)),
     "place-dtheta-1e300": (_yaml("place: [0.2, 0.2, 15]", "place: [0.2, 0.2, 1e300]"), ("angle",)),
     "place-angles-1e300": (GOOD_YAML + "planning: {place_angles: [0, 1e300]}\n", ("angle",)),
