@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -460,7 +461,7 @@ class _Builder:
             return None  # numbers that are not doubles would fail every later check
         table = self.table(values)
         uncertainty = self.uncertainty(values)
-        initial, obstacles = self.poses(values, kinds)
+        initial, obstacles = self.poses(values, kinds, table)
         goal = self.goal(kinds)
         self.check_table_goals(kinds, {entry.name for entry in initial}, goal)
         if any(d.is_error for d in self.diagnostics):
@@ -683,8 +684,13 @@ class _Builder:
         return float(value)
 
     def poses(
-        self, values: dict, kinds: dict[str, ObjectKind]
+        self, values: dict, kinds: dict[str, ObjectKind], table: Table | None = None
     ) -> tuple[list[InitialObject], dict[str, tuple[float, float, float]]]:
+        from arrange_up.io.planfile import MAX_POSE_REACH
+
+        # a spread wider than this says no more than the table's, and at 1e300 a part's
+        # shadow collapses to no area in double precision (as a plan file's poses)
+        reach = MAX_POSE_REACH * max(table.size) if table is not None else math.inf
         initial: list[InitialObject] = []
         obstacles: dict[str, tuple[float, float, float]] = {}
         on_table = [key[1] for key, v in values.items() if key[0] == "on-table" and v is True]
@@ -726,6 +732,15 @@ class _Builder:
                         f"init.{function}({name})",
                         rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
                         f"({function} {name}) is {num(float(value))}; expected a half-width >= 0",
+                    )
+                elif function != "dtheta" and value > reach:
+                    self.error(
+                        f"init.{function}({name})",
+                        rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
+                        f"({function} {name}) is {float(value):g} in, more than "
+                        f"{MAX_POSE_REACH} table sizes; expected a half-width of at most "
+                        f"{num(reach)} in (a spread wider than the table says no more than one "
+                        "as wide as it)",
                     )
                 elif function == "dtheta":
                     self.angle(

@@ -189,6 +189,10 @@ PDDL_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
         .replace("(>= (x A) 9.3) (<= (x A) 9.7)", "(>= (x A) 0.3) (<= (x A) 0.7)"),
         ("collision-free",),
     ),
+    "spread-1e300": (
+        _pddl("(= (manipulator-density-max) 0.45)", ON_TABLE + " (= (dx A) 1e300)"),
+        ("(dx A) is 1e+300 in", "at most 1000 in"),
+    ),
     "not-utf8": (GOOD_PDDL.encode() + b"; caf\xe9\n", ("UTF-8",)),
     "nested-parentheses": (GOOD_PDDL + "(" * 5000 + ")" * 5000, ("PDDL",)),
     "empty": ("", ("PDDL",)),
