@@ -247,6 +247,12 @@ PLAN_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
         ).replace('"distance": 1', f'"distance": {BIG}'),
         ("distance",),
     ),
+    "distance-1e300": (
+        _plan(
+            actions=[{"type": "push", "manipulator": "paddle", "pose": [1, 1, 0], "distance": 1}]
+        ).replace('"distance": 1', '"distance": 1e300'),
+        ("actions[0].distance", "at most 1000 in"),
+    ),
     "huge-integer": (_pose(f"[{HUGE}, 0.5, 0]"), ("digits",)),
     "angle-1e300": (_pose("[9.5, 0.5, 1e300]"), ("angle",)),
     "x-1e300": (_pose("[1e300, 0.5, 0]"), ("pose", "table sizes")),
