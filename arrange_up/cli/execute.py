@@ -24,6 +24,7 @@ from arrange_up.cli.shared import (
     seed_option,
     terminal_progress,
 )
+from arrange_up.evaluation.evaluate import MAX_ROLLOUTS
 from arrange_up.evaluation.records import RecordFileError, plan_hash
 from arrange_up.execution.episodes import EpisodeRecord, run_episode, run_episodes
 from arrange_up.execution.observations import SENSES
@@ -46,7 +47,11 @@ _DEFAULTS = ClosedLoopSettings()
     "encoders), every part's pose (a camera), or nothing.",
 )
 @click.option(
-    "--episodes", type=click.IntRange(1, None), default=20, show_default=True, help="Episodes."
+    "--episodes",
+    type=click.IntRange(1, MAX_ROLLOUTS),
+    default=20,
+    show_default=True,
+    help="Episodes (at most 1,000,000).",
 )
 @seed_option("Episode i's world and the loop's draws derive from (seed, i).")
 @click.option(
@@ -64,7 +69,7 @@ _DEFAULTS = ClosedLoopSettings()
 )
 @click.option(
     "--particles",
-    type=click.IntRange(1, None),
+    type=click.IntRange(1, 100_000),
     default=_DEFAULTS.particles,
     show_default=True,
     help="Particles of a replan's start belief (particles semantics).",
@@ -85,7 +90,7 @@ _DEFAULTS = ClosedLoopSettings()
 )
 @click.option(
     "--filter-particles",
-    type=click.IntRange(1, None),
+    type=click.IntRange(1, 100_000),
     default=_DEFAULTS.filter_particles,
     show_default=True,
     help="Particles of the belief conditioned on the observations.",

@@ -126,15 +126,20 @@ def _warn_stiff(shown: str, problem: ArrangementProblem) -> None:
     step (:func:`arrange_up.physics.simulation.stiff_manipulators`): the file is valid, but its
     simulated pushes oscillate and throw parts (a light, millimetre-scale paddle at the
     default ``kp``)."""
+    from arrange_up.io.yaml_settings import controller_factors
     from arrange_up.physics.simulation import STABLE_RATE, stiff_manipulators
 
     for stiff in stiff_manipulators(problem):
+        # the gain too stiff, as the file writes it (kp_angle is per the file's units)
+        factor = controller_factors(problem.units)[stiff.gain]
+        value = getattr(problem.controller, stiff.gain) / factor
+        ratio = "sqrt(kp / m)" if stiff.gain == "kp" else "sqrt(kp_angle / I)"
         click.echo(
-            f"{shown}: warning: controller: the compliant controller (kp "
-            f"{problem.controller.kp:g}) is too stiff for manipulator {stiff.name!r} at the "
-            f"physics' time step (sqrt(kp / m) x dt up to {stiff.rate:.2f}, stable below "
-            f"{STABLE_RATE:g}): its pushes oscillate and throw parts; give controller.kp at "
-            f"most {stiff.kp_max:.3g}, or kind: servo",
+            f"{shown}: warning: controller: the compliant controller ({stiff.gain} "
+            f"{value:g}) is too stiff for manipulator {stiff.name!r} at the "
+            f"physics' time step ({ratio} x dt up to {stiff.rate:.3g}, stable below "
+            f"{STABLE_RATE:g}): its pushes oscillate and throw parts; give "
+            f"controller.{stiff.gain} at most {stiff.kp_max / factor:.3g}, or kind: servo",
             err=True,
         )
 

@@ -12,6 +12,7 @@ import click
 from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
 from arrange_up.cli.shared import (
+    FiniteFloat,
     OutputFile,
     fail,
     library_default,
@@ -71,7 +72,7 @@ from arrange_up.transitions import available
 )
 @click.option(
     "--fps",
-    type=click.FloatRange(0.1, 60),
+    type=FiniteFloat(0.1, 60),
     default=library_default(animate_plan, "fps"),
     show_default=True,
     help="Frames per second of the animation.",

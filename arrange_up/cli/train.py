@@ -21,6 +21,7 @@ from arrange_up.cbst.model import rescore_model
 from arrange_up.cbst.model import train_cbst as run_training
 from arrange_up.cli.shared import (
     EXIT_NEGATIVE,
+    FiniteFloat,
     OutputDir,
     OutputFile,
     backend_choice,
@@ -113,7 +114,7 @@ def _echo_scores(scores: dict) -> None:
 )
 @click.option(
     "--quantile",
-    type=click.FloatRange(0.5, 1.0),
+    type=FiniteFloat(0.5, 1.0),
     default=DEFAULT_GENERATION.quantile,
     show_default=True,
     help="The quantile of each example's rollouts its targets are (1: their largest, the "
@@ -121,7 +122,7 @@ def _echo_scores(scores: dict) -> None:
 )
 @click.option(
     "--block-half",
-    type=(click.FloatRange(min=0.0, min_open=True),) * 3,
+    type=(FiniteFloat(min=0.0, min_open=True),) * 3,
     default=DEFAULT_GENERATION.domain.block_half,
     show_default=True,
     help="The training domain: the largest half-widths of a block's belief (in, in, deg).",

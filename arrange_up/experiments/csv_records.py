@@ -104,7 +104,16 @@ def done_keys(path: Path, fields: Sequence[str]) -> set[tuple[str, ...]]:
     """The ``fields`` columns of every row already in ``path`` (none when it does not exist)."""
     if not Path(path).exists():
         return set()
-    return {tuple(row[f] or "" for f in fields) for row in read_csv(path)}
+    rows = read_csv(path)
+    header = list(rows[0]) if rows else []
+    missing = [f for f in fields if rows and f not in header]
+    if missing:  # another file's columns (a renamed or lost header): not this experiment's CSV
+        raise CsvRecordsError(
+            f"{path}: its columns ({', '.join(str(c) for c in header)}) lack "
+            f"{', '.join(missing)}, expected in this experiment's CSV; repair the header or "
+            "write to another output directory"
+        )
+    return {tuple(row[f] or "" for f in fields) for row in rows}
 
 
 def settings_path(path: Path) -> Path:

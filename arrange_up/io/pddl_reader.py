@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -249,6 +250,26 @@ class _Text:
         match = re.search(pattern, self.code, flags=re.IGNORECASE)
         return self.position(match.start()) if match else (None, None)
 
+    def assigned_again(self) -> list[tuple[str, int, int]]:
+        """Each numeric fluent ``:init`` sets a second time (whatever its case), as written
+        there, with the line and column of the second ``(=``. A reader keeps one of the values
+        and drops the other without a word, so the file is ambiguous."""
+        start = re.search(r"\(\s*:init\b", self.code, flags=re.IGNORECASE)
+        if start is None:
+            return []
+        end = re.compile(r"\(\s*:(goal|metric|constraints)\b", flags=re.IGNORECASE)
+        stop = end.search(self.code, start.end())
+        section = self.code[start.end() : stop.start() if stop else len(self.code)]
+        seen: set[str] = set()
+        again = []
+        for match in re.finditer(r"\(\s*=\s*(\([^()]*\))", section):
+            fluent = match.group(1)
+            key = " ".join(fluent.strip("()").lower().split())
+            if key in seen:
+                again.append((fluent, *self.position(start.end() + match.start())))
+            seen.add(key)
+        return again
+
     def declared_again(self, name: str) -> tuple[int | None, int | None]:
         """Where ``:objects`` declares ``name`` (whatever its case) a second time, or, declared
         once (named like a type of the domain), where it does so."""
@@ -435,11 +456,12 @@ class _Builder:
             return None
         kinds, objects = self.objects()
         values = self.initial_values(kinds)
+        self.assigned_once()
         if any(d.is_error for d in self.diagnostics):
             return None  # numbers that are not doubles would fail every later check
         table = self.table(values)
         uncertainty = self.uncertainty(values)
-        initial, obstacles = self.poses(values, kinds)
+        initial, obstacles = self.poses(values, kinds, table)
         goal = self.goal(kinds)
         self.check_table_goals(kinds, {entry.name for entry in initial}, goal)
         if any(d.is_error for d in self.diagnostics):
@@ -527,6 +549,22 @@ class _Builder:
                     "written -15 or (- 15))",
                 )
         return out
+
+    def assigned_once(self) -> None:
+        """Refuse a numeric fluent that ``:init`` sets twice (the reader would keep one value)."""
+        if self.located is None:
+            return
+        for fluent, line, column in self.located.assigned_again():
+            self.diagnostics.append(
+                Diagnostic(
+                    self.source,
+                    line,
+                    column,
+                    f"init.{fluent.strip('()').split()[0]}",
+                    f"{' '.join(fluent.split())} is set a second time; expected each value set "
+                    "once in :init",
+                )
+            )
 
     def finite(self, number: Fraction, path: str, pattern: str) -> bool:
         """Whether ``number`` is a usable double; reported at ``pattern`` when it is not."""
@@ -646,8 +684,13 @@ class _Builder:
         return float(value)
 
     def poses(
-        self, values: dict, kinds: dict[str, ObjectKind]
+        self, values: dict, kinds: dict[str, ObjectKind], table: Table | None = None
     ) -> tuple[list[InitialObject], dict[str, tuple[float, float, float]]]:
+        from arrange_up.io.planfile import MAX_POSE_REACH
+
+        # a spread wider than this says no more than the table's, and at 1e300 a part's
+        # shadow collapses to no area in double precision (as a plan file's poses)
+        reach = MAX_POSE_REACH * max(table.size) if table is not None else math.inf
         initial: list[InitialObject] = []
         obstacles: dict[str, tuple[float, float, float]] = {}
         on_table = [key[1] for key, v in values.items() if key[0] == "on-table" and v is True]
@@ -689,6 +732,15 @@ class _Builder:
                         f"init.{function}({name})",
                         rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
                         f"({function} {name}) is {num(float(value))}; expected a half-width >= 0",
+                    )
+                elif function != "dtheta" and value > reach:
+                    self.error(
+                        f"init.{function}({name})",
+                        rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
+                        f"({function} {name}) is {float(value):g} in, more than "
+                        f"{MAX_POSE_REACH} table sizes; expected a half-width of at most "
+                        f"{num(reach)} in (a spread wider than the table says no more than one "
+                        "as wide as it)",
                     )
                 elif function == "dtheta":
                     self.angle(

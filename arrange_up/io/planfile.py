@@ -135,6 +135,13 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
             raise PlanFileError(
                 f"{where}.distance: expected a non-negative number, got {_shown(distance)}"
             )
+        reach = MAX_POSE_REACH * max(problem.table.size)
+        if units.length_in(distance) > reach:  # as a pose: a push thousands of tables long
+            raise PlanFileError(
+                f"{where}.distance: {_shown(distance)} {units.length} is more than "
+                f"{MAX_POSE_REACH} table sizes; expected a push of at most "
+                f"{units.length_out(reach):g} {units.length} (docs/plan-format.md)"
+            )
         return Push(
             name_of("manipulator", (ObjectKind.MANIPULATOR,)), pose_of(), units.length_in(distance)
         )

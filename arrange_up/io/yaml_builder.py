@@ -112,6 +112,7 @@ class ProblemBuilder(NodeReader):
         if objects is None:  # too many to check: the rest would be a flood of messages
             return None
         initial = self.initial(root, objects)
+        self.check_spread(table, initial)
         self.check_placement(table, objects, initial)
         goal = self.goal(root, objects)
         uncertainty = self.settings_reader.uncertainty(root)
@@ -484,6 +485,29 @@ class ProblemBuilder(NodeReader):
             if obj is not None and entry is not None:
                 entries.append((entry, value_node))
         return entries
+
+    def check_spread(self, table: Table | None, initial: list[tuple[InitialObject, Node]]) -> None:
+        """Refuse an initial position spread of more than ``MAX_POSE_REACH`` table sizes (as a
+        plan file's poses): wider says no more than one as wide as the table, and far enough
+        out (1e300) a part's shadow collapses to no area in double precision."""
+        from arrange_up.io.planfile import MAX_POSE_REACH
+
+        if table is None:
+            return
+        limit = MAX_POSE_REACH * max(table.size)
+        for entry, node in initial:
+            if not node.is_map or not node.has("uncertainty"):
+                continue
+            items = node.child("uncertainty").items()
+            for value, item in zip(entry.uncertainty[:2], items, strict=False):
+                if value > limit:
+                    self.error(
+                        item,
+                        f"half-width {fmt(item.value)} {self.units.length} is more than "
+                        f"{MAX_POSE_REACH} table sizes; expected at most "
+                        f"{fmt(limit / self.units.length_factor)} {self.units.length} (a "
+                        f"spread wider than the table says no more than one as wide as it)",
+                    )
 
     def initial_entry(self, node: Node, name: str) -> InitialObject | None:
         if not self.mapping(node, "a mapping {pose: [x, y, theta], uncertainty: [dx, dy, dtheta]}"):

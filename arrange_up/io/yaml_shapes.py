@@ -88,6 +88,13 @@ class ShapeReader(NodeReader):
         if size is None:
             return None
         width, height = (self.units.length_in(v) for v in size)
+        if not width * height > 0.0:  # both > 0, but the area rounds to zero (1e-300 x 1e-300)
+            self.error(
+                node,
+                f"the box {fmt(size[0])} x {fmt(size[1])} is degenerate (its area rounds to "
+                "zero); expected a box of non-zero area",
+            )
+            return None
         return box_shape(width, height, name)
 
     def points(self, node: Node) -> list[Point] | None:

@@ -1198,7 +1198,10 @@ class StiffManipulator(NamedTuple):
     rate: float
     """The larger of ``sqrt(Kp / m) dt`` and ``sqrt(Kp_angle / I) dt``."""
     kp_max: float
-    """The largest ``kp`` that keeps the rate at :data:`STABLE_RATE`."""
+    """The largest value of :attr:`gain` (internal units) that keeps the rate at
+    :data:`STABLE_RATE`."""
+    gain: str = "kp"
+    """The gain too stiff: ``kp``, or ``kp_angle`` when an explicit angle gain is."""
 
 
 def stiff_manipulators(
@@ -1224,8 +1227,14 @@ def stiff_manipulators(
         gains = compliant_gains(controller, settings, mass, moment, body.radius, force)
         kp, kp_a = gains.kp, gains.kp_angle
         dt = settings.dt
-        rate = max(math.sqrt(kp / mass) * dt, math.sqrt(kp_a / moment) * dt)
+        linear, angular = math.sqrt(kp / mass) * dt, math.sqrt(kp_a / moment) * dt
+        rate = max(linear, angular)
         if rate > STABLE_RATE:
+            if controller.kp_angle is not None and angular > max(linear, STABLE_RATE):
+                # the explicit angle gain is what is too stiff: lowering kp would not help
+                limit = moment * (STABLE_RATE / dt) ** 2
+                found.append(StiffManipulator(spec.name, rate, limit, "kp_angle"))
+                continue
             limit = mass * (STABLE_RATE / dt) ** 2
             if controller.kp_angle is None:
                 limit = min(limit, moment / body.radius**2 * (STABLE_RATE / dt) ** 2)

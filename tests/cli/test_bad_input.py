@@ -69,6 +69,10 @@ YAML_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "initial-angle-1e300": (_yaml("pose: [2, 2, 0]", "pose: [2, 2, 1e300]"), ("angle",)),
     "goal-angle-1e300": (_yaml("poses: {A: [5, 2, 0]}", "poses: {A: [5, 2, 1e300]}"), ("angle",)),
     "tolerance-angle-1e300": (_yaml("[0.2, 0.2, 15]", "[0.2, 0.2, 1e300]"), ("angle",)),
+    "initial-dx-1e300": (
+        _yaml("[0.1, 0.1, 5]", "[1e300, 0.1, 5]"),
+        ("initial.A.uncertainty[0]", "at most 1000 in"),
+    ),
     "initial-dtheta-1e300": (_yaml("[0.1, 0.1, 5]", "[0.1, 0.1, 1e300]"), ("angle",)),
     "place-dtheta-1e300": (_yaml("place: [0.2, 0.2, 15]", "place: [0.2, 0.2, 1e300]"), ("angle",)),
     "place-angles-1e300": (GOOD_YAML + "planning: {place_angles: [0, 1e300]}\n", ("angle",)),
@@ -111,6 +115,7 @@ YAML_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "nan-pose": (_yaml("pose: [2, 2, 0]", "pose: [.nan, 2, 0]"), ("finite",)),
     "inf-tolerance": (_yaml("[0.2, 0.2, 15]", "[.inf, 0.2, 15]"), ("finite",)),
     "zero-table": (_yaml("size: [10, 5]", "size: [0, 5]"), ("> 0",)),
+    "box-area-rounds-to-zero": (_yaml("box: [1, 1]", "box: [1e-300, 1e-300]"), ("degenerate",)),
     "negative-friction": (_yaml("friction: [0.25", "friction: [-0.25"), (">= 0",)),
     "duplicate-key": (GOOD_YAML + "name: two\n", ("duplicate",)),
     "name-is-a-list": (_yaml("name: one", "name: [1, 2]"), ("name",)),
@@ -184,6 +189,10 @@ PDDL_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
         .replace("(>= (x A) 9.3) (<= (x A) 9.7)", "(>= (x A) 0.3) (<= (x A) 0.7)"),
         ("collision-free",),
     ),
+    "spread-1e300": (
+        _pddl("(= (manipulator-density-max) 0.45)", ON_TABLE + " (= (dx A) 1e300)"),
+        ("(dx A) is 1e+300 in", "at most 1000 in"),
+    ),
     "not-utf8": (GOOD_PDDL.encode() + b"; caf\xe9\n", ("UTF-8",)),
     "nested-parentheses": (GOOD_PDDL + "(" * 5000 + ")" * 5000, ("PDDL",)),
     "empty": ("", ("PDDL",)),
@@ -191,6 +200,10 @@ PDDL_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "unknown-type": (_pddl("A - block-1x1", "A - gizmo"), ("gizmo",)),
     "no-table": (_pddl("(= (table-width) 10) (= (table-depth) 5)", ""), ("table-width",)),
     "negative-noise": (_pddl("(= (place-dx) 0.2)", "(= (place-dx) -0.2)"), (">= 0",)),
+    "fluent-set-twice": (
+        _pddl("(= (place-dx) 0.2)", "(= (place-dx) 0.2) (= (PLACE-dx) 0.3)"),
+        (":25:", "(place-dx) is set a second time"),
+    ),
     "empty-goal-interval": (_pddl("(<= (x A) 9.7)", "(<= (x A) 9.1)"), ("empty",)),
     "overlapping-start": (
         _pddl(
@@ -233,6 +246,12 @@ PLAN_CASES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
             actions=[{"type": "push", "manipulator": "paddle", "pose": [1, 1, 0], "distance": 1}]
         ).replace('"distance": 1', f'"distance": {BIG}'),
         ("distance",),
+    ),
+    "distance-1e300": (
+        _plan(
+            actions=[{"type": "push", "manipulator": "paddle", "pose": [1, 1, 0], "distance": 1}]
+        ).replace('"distance": 1', '"distance": 1e300'),
+        ("actions[0].distance", "at most 1000 in"),
     ),
     "huge-integer": (_pose(f"[{HUGE}, 0.5, 0]"), ("digits",)),
     "angle-1e300": (_pose("[9.5, 0.5, 1e300]"), ("angle",)),
@@ -441,12 +460,34 @@ COMMAND_CASES: dict[str, tuple[list[str], tuple[str, ...]]] = {
         [*QUICK_EVALUATE, "--backend", "local", "--scheduler", "tcp://127.0.0.1:1"],
         ("--scheduler",),
     ),
+    # a problem that does not exist: a count not refused would end at once with another message
+    "execute-episodes-huge": (
+        ["execute", "no-such-problem", "--episodes", "99999999999999999999"],
+        ("--episodes", "1000000"),
+    ),
+    "execute-particles-huge": (
+        ["execute", "no-such-problem", "--particles", "99999999999999999999"],
+        ("--particles", "100000"),
+    ),
+    "execute-filter-particles-huge": (
+        ["execute", "no-such-problem", "--filter-particles", "99999999999999999999"],
+        ("--filter-particles", "100000"),
+    ),
     "repair-seed-negative": ([*QUICK_REPAIR, "--seed", "-1"], ("--seed",)),
     "repair-particles-zero": ([*QUICK_REPAIR, "--particles", "0"], ("--particles",)),
     "repair-output-in-a-file": ([*QUICK_REPAIR, "-o", "{tmp}/file/r.json"], ("--output",)),
     "show-svg-as-gif": (["show", "blocks-1", "-o", "{tmp}/b.gif"], ("--output", ".svg")),
     "show-no-suffix": (["show", "blocks-1", "-o", "{tmp}/picture"], ("--output", ".png")),
     "show-output-in-a-file": (["show", "blocks-1", "-o", "{tmp}/file/b.png"], ("--output",)),
+    "show-fps-nan": (
+        ["show", "blocks-1", "--plan", "{plan}", "--animate", "{tmp}/a.gif", "--fps", "nan"],
+        ("--fps", "finite"),
+    ),
+    "train-quantile-nan": ([*QUICK_TRAIN, "--quantile", "nan"], ("--quantile", "finite")),
+    "train-block-half-inf": (
+        [*QUICK_TRAIN, "--block-half", "0.1", "inf", "5"],
+        ("--block-half", "finite"),
+    ),
     "show-seed-negative": (
         ["show", "blocks-1", "--plan", "{plan}", "--seed", "-1", "-o", "{tmp}/s.png"],
         ("--seed",),

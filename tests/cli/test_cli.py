@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 from catalogue import text
 from click.testing import CliRunner
 
 from arrange_up.cli import main
+
+REPOSITORY = Path(__file__).resolve().parents[2]
 
 BAD = textwrap.dedent(
     """\
@@ -82,6 +86,26 @@ def test_check_warns_of_a_controller_too_stiff_for_the_paddle(tmp_path):
     )
     assert "manipulator 'tip'" in result.output and "give controller.kp at most" in result.output
     assert "warning" not in run("check", "blocks-2").output
+
+
+def test_a_too_stiff_angle_gain_is_named_with_its_limit_in_the_files_units(tmp_path):
+    # an explicit kp_angle too stiff was reported as "kp 300" with a 150-digit rate and a kp
+    # limit that could not help; the warning names kp_angle and its limit, per degree
+    blocks = (REPOSITORY / "domains" / "blocks-1.yaml").read_text(encoding="utf-8")
+    stiff = tmp_path / "stiff.yaml"
+
+    def check(kp_angle: str) -> str:
+        stiff.write_text(blocks + f"controller: {{kind: compliant, kp_angle: {kp_angle}}}\n")
+        result = run("check", str(stiff))
+        assert result.exit_code == 0, result.output
+        return result.output
+
+    output = check("1e300")
+    assert "(kp_angle 1e+300) is too stiff" in output
+    assert "sqrt(kp_angle / I) x dt up to 1.2e+149" in output
+    limit = float(re.search(r"give controller.kp_angle at most ([0-9.e+]+),", output)[1])
+    assert "too stiff" not in check(f"{limit * 0.99:g}")
+    assert "too stiff" in check(f"{limit * 1.01:g}")
 
 
 def test_show_writes_png(tmp_path):

@@ -147,3 +147,24 @@ def test_the_rollouts_to_do_are_drawn_lazily():
         tracemalloc.stop()
     assert result.trials == 3
     assert peak < 4_000_000, peak
+
+
+def test_a_table_of_1e300_is_planned_within_the_timeout(tmp_path):
+    # the place rings about the grid ran to the table's size in steps of the grid before the
+    # search began (1e300 / 0.1 rings), past --timeout: at most MAX_RINGS are built now
+    from arrange_up.planning.generators.places import MAX_RINGS, rings
+
+    start = time.monotonic()
+    assert len(rings(((0.5, 0.0), (0.0, 0.5)), 1e300)) == MAX_RINGS
+    assert len(rings(((0.5, 0.0), (0.0, 0.5)), 10.0)) == 19  # a real table: every ring
+    problem = tmp_path / "huge.yaml"
+    problem.write_text(
+        "name: huge\ntable: {size: [1e300, 1e300]}\nobjects:\n"
+        "  A: {kind: part, shape: {box: [1, 1]}}\n"
+        "  paddle: {kind: manipulator, shape: {box: [2.5, 0.15]}}\n"
+        "goal:\n  tolerance: [0.2, 0.2]\n  poses: {A: [5, 2, 0]}\n"
+    )
+    args = ["plan", str(problem), "--semantics", "deterministic", "--workers", "1"]
+    result = CliRunner().invoke(main, [*args, "--timeout", "30", "--quiet"])
+    assert result.exit_code in (0, 1), result.output
+    assert time.monotonic() - start < 60

@@ -219,3 +219,27 @@ def test_experiment_refuses_a_resumed_csv_with_a_bad_number_cell_exit_2(tmp_path
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 2, result.output
     assert "search-table.csv:4: byte 0xff is not UTF-8" in result.output
+
+
+@pytest.mark.parametrize("header", ["problem,runs,value", "\ufeffproblem,run,value", "p,1,2"])
+def test_a_header_without_the_key_columns_is_refused_not_a_key_error(tmp_path: Path, header):
+    # a renamed column, a byte-order mark or a lost header row: done_keys (read before the
+    # appender checks the columns) raised KeyError, a traceback of `experiment`
+    path = tmp_path / "t.csv"
+    path.write_text(f"{header}\np,1,2\n", encoding="utf-8")
+    refused = r"t\.csv: its columns \(.*\) lack (problem|run|problem, run), expected"
+    with pytest.raises(CsvRecordsError, match=refused):
+        done_keys(path, KEY)
+
+
+def test_experiment_refuses_a_resumed_csv_with_a_renamed_key_column_exit_2(tmp_path: Path):
+    args = ["experiment", "search-table", "--problems", "blocks-1", "--semantics"]
+    args += ["deterministic", "--output-dir", str(tmp_path), "--quiet"]
+    assert CliRunner().invoke(main, args).exit_code == 0
+    path = tmp_path / "search-table.csv"
+    path.write_bytes(path.read_bytes().replace(b"problem", b"problme", 1))
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2, result.output
+    assert "search-table.csv: its columns (" in result.output
+    assert "problme" in result.output and ") lack problem, expected" in result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)

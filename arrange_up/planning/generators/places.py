@@ -44,6 +44,11 @@ from arrange_up.planning.generators.targets import GoalTargets
 #: grid's eight directions only, so that a part with no clear place anywhere costs few tests.
 FULL_RINGS = 3
 
+#: At most this many rings, however large the table is against the grid's step (a table of
+#: 1e300 would otherwise have rings without end before the search starts, past any timeout);
+#: a shipped problem has tens.
+MAX_RINGS = 1000
+
 
 @functools.lru_cache(maxsize=256)
 def rings(
@@ -56,7 +61,7 @@ def rings(
     left before right)."""
     step = max(max(abs(dx), abs(dy)) for dx, dy in grid)
     found = []
-    for k in range(2, int(reach / step) + 1):
+    for k in range(2, int(min(reach / step, MAX_RINGS + 1)) + 1):
         if k <= FULL_RINGS:
             points = [
                 (i, j)
