@@ -105,9 +105,12 @@ class GoalTest:
     def excess(self, poses: np.ndarray, names: Sequence[str]) -> np.ndarray | None:
         """Per particle, part and dimension: how far beyond the tolerance (0 where within)."""
         coords = self.coordinates(poses, names)
-        if coords is None:
-            return None
-        beyond: np.ndarray = np.maximum(np.abs(coords - self.targets) - self.tolerance - EPS, 0.0)
+        return None if coords is None else self._beyond(coords, self.targets)
+
+    def _beyond(self, coords: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """How far goal-frame ``coords`` lie beyond the tolerance about ``targets`` (their
+        goal parts' rows of :attr:`targets`), per dimension; 0 where within."""
+        beyond: np.ndarray = np.maximum(np.abs(coords - targets) - self.tolerance - EPS, 0.0)
         return beyond
 
     # -- tests -----------------------------------------------------------------------------
@@ -145,8 +148,7 @@ class GoalTest:
         coords = self._coordinates(poses, index, which) if which else None
         judged: tuple[PartMiss, ...] = ()
         if coords is not None:
-            beyond = np.maximum(np.abs(coords - self.targets[which]) - self.tolerance - EPS, 0.0)
-            worst = beyond.max(axis=0)
+            worst = self._beyond(coords, self.targets[which]).max(axis=0)
             judged = tuple(
                 PartMiss(self.parts[k], False, as_triple(float(v) for v in worst[i]))
                 for i, k in enumerate(which)

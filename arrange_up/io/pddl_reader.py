@@ -35,7 +35,13 @@ from arrange_up.io.pddl_domain import (
     num,
 )
 from arrange_up.io.shape_catalogue import load_catalogue
-from arrange_up.io.validation import Placed, too_many_objects
+from arrange_up.io.validation import (
+    MAX_POSE_REACH,
+    WIDE_SPREAD,
+    Placed,
+    pose_reach,
+    too_many_objects,
+)
 from arrange_up.model.errors import Diagnostic, ProblemFormatError, sort_diagnostics
 from arrange_up.model.problem import (
     ArrangementProblem,
@@ -686,11 +692,7 @@ class _Builder:
     def poses(
         self, values: dict, kinds: dict[str, ObjectKind], table: Table | None = None
     ) -> tuple[list[InitialObject], dict[str, tuple[float, float, float]]]:
-        from arrange_up.io.planfile import MAX_POSE_REACH
-
-        # a spread wider than this says no more than the table's, and at 1e300 a part's
-        # shadow collapses to no area in double precision (as a plan file's poses)
-        reach = MAX_POSE_REACH * max(table.size) if table is not None else math.inf
+        reach = pose_reach(table.size) if table is not None else math.inf
         initial: list[InitialObject] = []
         obstacles: dict[str, tuple[float, float, float]] = {}
         on_table = [key[1] for key, v in values.items() if key[0] == "on-table" and v is True]
@@ -739,8 +741,7 @@ class _Builder:
                         rf"\(\s*{function}\s+{re.escape(name)}\s*\)",
                         f"({function} {name}) is {float(value):g} in, more than "
                         f"{MAX_POSE_REACH} table sizes; expected a half-width of at most "
-                        f"{num(reach)} in (a spread wider than the table says no more than one "
-                        "as wide as it)",
+                        f"{num(reach)} in ({WIDE_SPREAD})",
                     )
                 elif function == "dtheta":
                     self.angle(

@@ -43,7 +43,7 @@ from typing import Any, TypeGuard
 
 from arrange_up.counts import is_number
 from arrange_up.io.files import text_place, undecodable_place
-from arrange_up.io.validation import angle_problem
+from arrange_up.io.validation import MAX_POSE_REACH, angle_problem, pose_reach
 from arrange_up.io.yaml_settings import SERVO_KEYS, controller_factors
 from arrange_up.io.yaml_source import long_number
 from arrange_up.model.problem import (
@@ -113,7 +113,7 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
         ):
             raise PlanFileError(f"{where}.pose: expected [x, y, theta] numbers, got {_shown(pose)}")
         internal = units.pose_in(as_triple(pose))
-        reach = MAX_POSE_REACH * max(problem.table.size)
+        reach = pose_reach(problem.table.size)
         for axis, value, size in zip("xy", internal[:2], problem.table.size, strict=True):
             if not -reach <= value <= size + reach:
                 raise PlanFileError(
@@ -135,7 +135,7 @@ def action_from_json(data: Any, units: Units, problem: ArrangementProblem, where
             raise PlanFileError(
                 f"{where}.distance: expected a non-negative number, got {_shown(distance)}"
             )
-        reach = MAX_POSE_REACH * max(problem.table.size)
+        reach = pose_reach(problem.table.size)
         if units.length_in(distance) > reach:  # as a pose: a push thousands of tables long
             raise PlanFileError(
                 f"{where}.distance: {_shown(distance)} {units.length} is more than "
@@ -251,11 +251,6 @@ MAX_DEPTH = 32
 #: ``/dev/zero``) from taking the memory and time of every command that reads plans.
 MAX_PLAN_BYTES = 16 * 2**20
 MAX_PLAN_ACTIONS = 10_000
-#: How far from the table an action's pose may be, in table sizes (the larger of its width
-#: and depth). Pushes start just off an edge and places stay on it; a pose thousands of
-#: tables away means nothing, and far enough out (1e300) a part's outline collapses to no
-#: area in double precision.
-MAX_POSE_REACH = 100
 
 
 def _read_document(path: Path) -> Any:

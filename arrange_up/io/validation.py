@@ -80,10 +80,24 @@ MAX_LISTED_OVERLAPS = 100
 #: planner's timeout: 10,000 parts kept ``plan --timeout`` waiting far past it. A count beyond
 #: this is refused when the file is read.
 MAX_OBJECTS = 200
+#: How far from the table an action's pose may be, and how wide an initial position spread,
+#: in table sizes (the larger of its width and depth): :func:`pose_reach`. Pushes start just
+#: off an edge and places stay on it; a pose thousands of tables away means nothing, a spread
+#: wider than the table says no more than one as wide as it, and far enough out (1e300) a
+#: part's outline collapses to no area in double precision.
+MAX_POSE_REACH = 100
+#: Why a spread beyond :func:`pose_reach` is refused, as the readers' messages say it.
+WIDE_SPREAD = "a spread wider than the table says no more than one as wide as it"
 #: Draws :func:`unsampleable` makes: the particle sampler gives up on a particle after as many.
 SAMPLE_DRAWS = 1000
 
 Bounds = tuple[float, float, float, float]
+
+
+def pose_reach(table_size: Sequence[float]) -> float:
+    """:data:`MAX_POSE_REACH` table sizes, in the table's units (inches inside the planner):
+    the farthest a pose may lie beyond the table, the widest an initial position spread."""
+    return MAX_POSE_REACH * max(table_size)
 
 
 def too_many_objects(count: int) -> str | None:

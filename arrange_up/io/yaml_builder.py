@@ -12,7 +12,14 @@ import re
 from dataclasses import dataclass
 
 from arrange_up.io import validation
-from arrange_up.io.validation import MAX_LISTED_OVERLAPS, Placed, too_many_objects
+from arrange_up.io.validation import (
+    MAX_LISTED_OVERLAPS,
+    MAX_POSE_REACH,
+    WIDE_SPREAD,
+    Placed,
+    pose_reach,
+    too_many_objects,
+)
 from arrange_up.io.yaml_settings import (
     SettingsReader,
 )
@@ -487,14 +494,11 @@ class ProblemBuilder(NodeReader):
         return entries
 
     def check_spread(self, table: Table | None, initial: list[tuple[InitialObject, Node]]) -> None:
-        """Refuse an initial position spread of more than ``MAX_POSE_REACH`` table sizes (as a
-        plan file's poses): wider says no more than one as wide as the table, and far enough
-        out (1e300) a part's shadow collapses to no area in double precision."""
-        from arrange_up.io.planfile import MAX_POSE_REACH
-
+        """Refuse an initial position spread beyond
+        :func:`~arrange_up.io.validation.pose_reach` (as a plan file's poses)."""
         if table is None:
             return
-        limit = MAX_POSE_REACH * max(table.size)
+        limit = pose_reach(table.size)
         for entry, node in initial:
             if not node.is_map or not node.has("uncertainty"):
                 continue
@@ -505,8 +509,8 @@ class ProblemBuilder(NodeReader):
                         item,
                         f"half-width {fmt(item.value)} {self.units.length} is more than "
                         f"{MAX_POSE_REACH} table sizes; expected at most "
-                        f"{fmt(limit / self.units.length_factor)} {self.units.length} (a "
-                        f"spread wider than the table says no more than one as wide as it)",
+                        f"{fmt(limit / self.units.length_factor)} {self.units.length} "
+                        f"({WIDE_SPREAD})",
                     )
 
     def initial_entry(self, node: Node, name: str) -> InitialObject | None:
