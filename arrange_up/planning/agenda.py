@@ -24,8 +24,18 @@ them, its pose is certain. The agenda therefore
 Nothing solvable by the full search is lost: where the agenda fails (a subgoal fails whatever
 the grouping, or the agenda has spent the run's node limit), the full search runs with the
 whole node limit in the time left. :class:`AgendaRecord` says which of them found the plan.
-The agenda applies to absolute goals of two or more parts; a relative goal (its parts hold
-their goal only with respect to a reference that may end anywhere) is searched whole.
+
+The agenda applies to absolute goals of two or more parts. A relative goal (its parts hold
+their goal only with respect to a reference that may end anywhere) of at least
+:data:`MIN_GROUNDED` parts, the reference included, on a table with a corner of two walls, is
+first *grounded* (:func:`grounded`): the whole outline, in its own orientation (the reference
+turned to 0), is put flush into a corner of two walls, the corner that then lies nearest the
+reference, and that absolute goal is built part by part as above (the walls hold the reference
+while its mates are pressed against it). The relative goal itself is then a last subgoal,
+searched from the belief the grounded agenda reached: where every particle already holds it,
+that search ends at once with no action. Where the grounded agenda fails, the full search
+runs on the relative goal. A relative goal that is not grounded (fewer parts, no corner of two
+walls, or no corner the outline fits in clear of the obstacles and fixtures) is searched whole.
 """
 
 from __future__ import annotations
@@ -37,12 +47,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import shapely
+from shapely.affinity import translate
 from shapely.geometry import Point, box
 from shapely.geometry.base import BaseGeometry
 
 from arrange_up.geometry.boxes import wall_boxes
+from arrange_up.geometry.se2 import compose
 from arrange_up.geometry.shapes import footprint
-from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind
+from arrange_up.model.problem import ArrangementProblem, Goal, ObjectKind, Pose
 from arrange_up.planning.config import ProgressCallback
 from arrange_up.search import SearchStatus
 
@@ -52,10 +65,12 @@ if TYPE_CHECKING:
 __all__ = [
     "CONTACT_GAP",
     "MAX_GROUP",
+    "MIN_GROUNDED",
     "MIN_SUBGOAL_NODES",
     "AgendaRecord",
     "SubSearch",
     "goal_order",
+    "grounded",
     "parts_label",
     "plan_by_agenda",
     "restricted",
@@ -66,6 +81,8 @@ __all__ = [
 CONTACT_GAP = 0.05
 #: A contact shorter than this (in) is a corner meeting, which presses nothing.
 MIN_CONTACT = 0.2
+#: The fewest parts (the reference included) of a relative goal the agenda grounds in a corner.
+MIN_GROUNDED = 3
 #: The most parts one subgoal adds (a part, merged with its successor or its predecessor).
 MAX_GROUP = 3
 #: The fewest nodes a subgoal's search may expand per part it adds.
@@ -91,7 +108,9 @@ class AgendaRecord:
     the plan's order, when the agenda found the plan (else those it had finished when it
     failed); ``solved_by``: ``"agenda"`` or ``"full search"``, None when neither found a plan;
     ``expanded``: the nodes the agenda's searches expanded (the full search's come on top);
-    ``failed_at``: the parts the agenda was adding when it gave up (None if it did not).
+    ``failed_at``: the parts the agenda was adding when it gave up (None if it did not);
+    ``grounded``: for a relative goal the agenda grounded (:func:`grounded`), the pose it gave
+    the reference, in inches and radians (None for an absolute goal).
     """
 
     order: tuple[str, ...]
@@ -99,14 +118,16 @@ class AgendaRecord:
     solved_by: str | None
     expanded: int
     failed_at: tuple[str, ...] | None = None
+    grounded: Pose | None = None
 
     def line(self) -> str:
         """One line for the command line: which search found the plan, or where the agenda
         stopped."""
         n = len(self.subgoals)
+        corner = "grounded in a corner; " if self.grounded is not None else ""
         if self.solved_by == "agenda":
             return (
-                f"solved by the agenda ({n} subgoal{'s' if n != 1 else ''}: "
+                f"solved by the agenda ({corner}{n} subgoal{'s' if n != 1 else ''}: "
                 f"{' '.join('+'.join(group) for group in self.subgoals)})"
             )
         done = sum(len(group) for group in self.subgoals)
@@ -114,6 +135,8 @@ class AgendaRecord:
             f"the agenda failed at {parts_label(done, len(self.failed_at), len(self.order))} "
             f"({'+'.join(self.failed_at)}) after {self.expanded} nodes"
             if self.failed_at
+            else f"the grounded agenda's plan missed the relative goal after {self.expanded} nodes"
+            if self.grounded is not None and done == len(self.order)
             else f"the agenda stopped at part {done + 1} of {len(self.order)}"
         )
         if self.solved_by == "full search":
@@ -128,6 +151,7 @@ class AgendaRecord:
             "solved_by": self.solved_by,
             "expanded": self.expanded,
             "failed_at": None if self.failed_at is None else list(self.failed_at),
+            "grounded": self.grounded is not None,
         }
 
 
@@ -151,6 +175,47 @@ def restricted(problem: ArrangementProblem, parts: tuple[str, ...]) -> Arrangeme
     goal = problem.goal
     targets = tuple((name, pose) for name, pose in goal.targets if name in keep)
     return dataclasses.replace(problem, goal=Goal(targets, goal.tolerance, goal.reference))
+
+
+# -- grounding a relative goal ---------------------------------------------------------------
+def grounded(problem: ArrangementProblem) -> ArrangementProblem | None:
+    """``problem`` with its relative goal made absolute in a corner of two walls (module
+    docstring), or None where the goal is absolute, has fewer than :data:`MIN_GROUNDED` parts
+    (the reference included), or no corner of two walls holds the outline clear of the
+    obstacles and fixtures standing on the table. The tolerance is the goal's."""
+    goal = problem.goal
+    reference = goal.reference
+    if reference is None or len(goal.parts) + 1 < MIN_GROUNDED:
+        return None
+    outline = [(reference, (0.0, 0.0, 0.0)), *goal.targets]
+    shapes = [footprint(problem.object(name).shape.parts, pose) for name, pose in outline]
+    x0, y0, x1, y1 = shapely.union_all(shapes).bounds
+    width, depth = problem.table.size
+    standing = _standing(problem)
+    walls = set(problem.table.walls)
+    best: tuple[float, Pose] | None = None
+    for side, end in (("left", "bottom"), ("right", "bottom"), ("left", "top"), ("right", "top")):
+        if side not in walls or end not in walls:
+            continue
+        dx = -x0 if side == "left" else width - x1
+        dy = -y0 if end == "bottom" else depth - y1
+        if x1 - x0 > width or y1 - y0 > depth:
+            continue
+        if any(
+            translate(shape, dx, dy).intersection(f).area > 1e-9
+            for shape in shapes
+            for f in standing
+        ):
+            continue
+        corner = Point(0.0 if side == "left" else width, 0.0 if end == "bottom" else depth)
+        distance = corner.distance(Point(dx, dy))
+        if best is None or distance < best[0] - 1e-9:
+            best = (distance, (dx, dy, 0.0))
+    if best is None:
+        return None
+    origin = best[1]
+    targets = tuple((name, compose(origin, pose)) for name, pose in outline)
+    return dataclasses.replace(problem, goal=Goal(targets, goal.tolerance, None))
 
 
 # -- the order -------------------------------------------------------------------------------
@@ -191,15 +256,19 @@ def _sides(shape: BaseGeometry, others: list[BaseGeometry]) -> list[int]:
 def _fixed_supports(problem: ArrangementProblem) -> list[BaseGeometry]:
     """What a part can be pressed against before any part is placed: the walls, and the
     obstacles and fixtures standing on the table at the start (at their initial poses)."""
-    supports: list[BaseGeometry] = [
-        box(*bounds) for bounds in wall_boxes(problem.table.size, problem.table.walls).values()
-    ]
+    walls = wall_boxes(problem.table.size, problem.table.walls).values()
+    return [box(*bounds) for bounds in walls] + _standing(problem)
+
+
+def _standing(problem: ArrangementProblem) -> list[BaseGeometry]:
+    """The footprints of the obstacles and fixtures standing on the table at the start."""
+    standing = []
     for spec in problem.objects:
         if spec.kind in (ObjectKind.OBSTACLE, ObjectKind.FIXTURE):
             initial = problem.initial_of(spec.name)
             if initial is not None:
-                supports.append(footprint(spec.shape.parts, initial.pose))
-    return supports
+                standing.append(footprint(spec.shape.parts, initial.pose))
+    return standing
 
 
 def _anchor(
@@ -264,7 +333,9 @@ def plan_by_agenda(
     :attr:`~arrange_up.planning.planner.PlanResult.agenda` records the agenda. When the agenda
     finds the plan, ``beliefs`` run through its subgoals' plans.
     """
-    order = goal_order(problem)
+    grounding = grounded(problem)
+    absolute = grounding or problem  # the goal built part by part
+    order = goal_order(absolute)
     if order is None:
         return search(problem, start, max_nodes, timeout, progress)
     started = time.monotonic()
@@ -291,7 +362,7 @@ def plan_by_agenda(
         belief = done[-1][1].beliefs[-1] if done else start  # type: ignore[index]  # solved
         stage = f"{parts_label(position, size, len(order))} ({'+'.join(group)})"
         result = search(
-            restricted(problem, order[: position + size]), belief, nodes, left(), staged(stage)
+            restricted(absolute, order[: position + size]), belief, nodes, left(), staged(stage)
         )
         spent.append(result)
         expanded += result.statistics.expanded
@@ -310,10 +381,26 @@ def plan_by_agenda(
         while sum(len(group) for group, _ in done) > position:
             done.pop()  # backtracking: the previous subgoal is searched again
     else:
-        return _joined(done, spent, _record(order, done, "agenda", expanded, None), max_nodes)
-    failed_at = order[position : position + size]
+        if absolute is problem:
+            return _joined(done, spent, _record(order, done, "agenda", expanded, None), max_nodes)
+        # the relative goal itself, from the belief the grounded agenda reached
+        nodes = max(0, min(per_part, max_nodes - expanded))
+        belief = done[-1][1].beliefs[-1]  # type: ignore[index]  # solved
+        result = search(problem, belief, nodes, left(), staged("the relative goal"))
+        spent.append(result)
+        expanded += result.statistics.expanded
+        if result.solved:
+            done.append(((), result))
+            record = _record(order, done, "agenda", expanded, None, grounding)
+            return _joined(done, spent, record, max_nodes)
+        if result.status in _FINAL:
+            record = _record(order, done, None, expanded, None, grounding)
+            return _with_spent(result, spent, record, max_nodes)
+        position, size = len(order), 0
+    failed_at = order[position : position + size] or None  # None: at the relative goal
     full = search(problem, start, max_nodes, left(), staged("full search"))
-    record = _record(order, done, "full search" if full.solved else None, expanded, failed_at)
+    solved_by = "full search" if full.solved else None
+    record = _record(order, done, solved_by, expanded, failed_at, grounding)
     return _with_spent(full, spent, record, max_nodes)
 
 
@@ -342,8 +429,14 @@ def _record(
     solved_by: str | None,
     expanded: int,
     failed_at: tuple[str, ...] | None,
+    grounding: ArrangementProblem | None = None,
 ) -> AgendaRecord:
-    return AgendaRecord(order, tuple(group for group, _ in done), solved_by, expanded, failed_at)
+    """The record of a run whose finished subgoals are ``done`` (the relative goal's last
+    search adds no parts, and is no subgoal); ``grounding`` the grounded goal the agenda
+    built (:func:`grounded`), None for an absolute goal."""
+    reference = None if grounding is None else grounding.goal.target(grounding.goal.parts[0])
+    subgoals = tuple(group for group, _ in done if group)
+    return AgendaRecord(order, subgoals, solved_by, expanded, failed_at, reference)
 
 
 def _with_spent(

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 from catalogue import tiny
 
+from arrange_up.belief.compiled import compile_problem
 from arrange_up.io.domains import load
+from arrange_up.io.generate import generate_problem
+from arrange_up.io.yaml_problem import load_problem_text
 from arrange_up.planning import agenda
 from arrange_up.planning.agenda import goal_order, restricted
 from arrange_up.planning.planner import plan
@@ -53,7 +58,10 @@ def test_a_failed_subgoal_is_searched_again_with_its_predecessor(monkeypatch):
     # together with A, from the start.
     monkeypatch.setattr(agenda, "goal_order", lambda problem: ("B", "A"))
     stages = []
-    result = plan(load("blocks-2"), semantics="deterministic", progress=stages.append)
+    # (a small node limit: A alone fails only once its share of the limit is spent)
+    result = plan(
+        load("blocks-2"), semantics="deterministic", progress=stages.append, max_nodes=400
+    )
     assert result.solved and result.agenda.solved_by == "agenda"
     assert result.agenda.subgoals == (("B", "A"),)
     # the progress counts a group's parts as the result line does: from the first it adds
@@ -68,12 +76,12 @@ def test_the_parts_a_subgoal_adds_are_labelled_from_its_first():
 def test_where_the_agenda_fails_the_full_search_plans(monkeypatch):
     monkeypatch.setattr(agenda, "goal_order", lambda problem: ("B", "A"))
     monkeypatch.setattr(agenda, "MAX_GROUP", 1)  # no regrouping: the agenda fails at A
-    result = plan(load("blocks-2"), semantics="deterministic")
+    result = plan(load("blocks-2"), semantics="deterministic", max_nodes=400)
     assert result.solved and result.agenda.solved_by == "full search"
     assert result.agenda.failed_at == ("A",) and result.agenda.subgoals == (("B",),)
     assert result.agenda.line().startswith("solved by the full search (the agenda failed at part 2")
     # the run's statistics count the agenda's nodes and the full search's
-    alone = plan(load("blocks-2"), semantics="deterministic", agenda=False)
+    alone = plan(load("blocks-2"), semantics="deterministic", agenda=False, max_nodes=400)
     assert result.stats["expanded"] == result.agenda.expanded + alone.stats["expanded"]
     assert result.actions == alone.actions
 
@@ -82,3 +90,44 @@ def test_where_the_agenda_fails_the_full_search_plans(monkeypatch):
 def test_the_agenda_plans_for_every_particle(semantics):
     result = plan(load("blocks-3"), semantics=semantics, particles=5, workers=1, validate=0)
     assert result.solved and result.agenda.solved_by == "agenda"
+
+
+def _relative(parts: int, walls: list[str] | None = None):
+    problem = load_problem_text(generate_problem("relative", parts, 0))
+    if walls is not None:
+        problem = dataclasses.replace(
+            problem, table=dataclasses.replace(problem.table, walls=tuple(walls))
+        )
+    return problem
+
+
+def test_a_relative_goal_is_grounded_flush_in_the_corner_nearest_its_reference():
+    problem = _relative(4)
+    base = agenda.grounded(problem)
+    assert base is not None and not base.goal.is_relative
+    reference = problem.goal.reference
+    assert base.goal.parts[0] == reference and base.goal.target(reference) == (0.5, 0.5, 0.0)
+    # the mates keep their places in the reference's frame
+    for name, (x, y, theta) in problem.goal.targets:
+        assert base.goal.target(name) == pytest.approx((0.5 + x, 0.5 + y, theta))
+    assert base.goal.tolerance == problem.goal.tolerance
+    # without a corner of two walls, or for a pair, or an absolute goal: none
+    assert agenda.grounded(_relative(4, ["left", "right"])) is None
+    assert agenda.grounded(_relative(4, ["bottom", "right"])).goal.target(reference)[1] == 0.5
+    assert agenda.grounded(_relative(2)) is None
+    assert agenda.grounded(load("blocks-3")) is None
+
+
+def test_a_grounded_relative_goal_is_built_part_by_part_then_checked_as_relative():
+    problem = _relative(4)
+    stages = []
+    result = plan(problem, particles=5, workers=1, validate=0, progress=stages.append)
+    assert result.solved and result.agenda.solved_by == "agenda"
+    assert result.agenda.grounded == (0.5, 0.5, 0.0)
+    assert result.agenda.line().startswith("solved by the agenda (grounded in a corner; 4 subgoals")
+    assert {s["stage"] for s in stages} >= {"part 1 of 4 (A)", "the relative goal"}
+    assert result.document(problem)["agenda"]["grounded"] is True
+    # the plan reaches the relative goal itself in every particle
+    assert compile_problem(problem).goal.satisfied_array(
+        result.beliefs[-1].poses, result.beliefs[-1].names()
+    )
