@@ -181,8 +181,9 @@ def restricted(problem: ArrangementProblem, parts: tuple[str, ...]) -> Arrangeme
 def grounded(problem: ArrangementProblem) -> ArrangementProblem | None:
     """``problem`` with its relative goal made absolute in a corner of two walls (module
     docstring), or None where the goal is absolute, has fewer than :data:`MIN_GROUNDED` parts
-    (the reference included), or no corner of two walls holds the outline clear of the
-    obstacles and fixtures standing on the table. The tolerance is the goal's."""
+    (the reference included), or no corner of two walls holds the outline (its footprints with
+    the reference at the origin, turned to 0) inside the table and clear of the obstacles and
+    fixtures standing on it. The tolerance is the goal's."""
     goal = problem.goal
     reference = goal.reference
     if reference is None or len(goal.parts) + 1 < MIN_GROUNDED:
@@ -193,14 +194,14 @@ def grounded(problem: ArrangementProblem) -> ArrangementProblem | None:
     width, depth = problem.table.size
     standing = _standing(problem)
     walls = set(problem.table.walls)
+    if x1 - x0 > width or y1 - y0 > depth:
+        return None
     best: tuple[float, Pose] | None = None
     for side, end in (("left", "bottom"), ("right", "bottom"), ("left", "top"), ("right", "top")):
         if side not in walls or end not in walls:
             continue
         dx = -x0 if side == "left" else width - x1
         dy = -y0 if end == "bottom" else depth - y1
-        if x1 - x0 > width or y1 - y0 > depth:
-            continue
         if any(
             translate(shape, dx, dy).intersection(f).area > 1e-9
             for shape in shapes
@@ -327,7 +328,8 @@ def plan_by_agenda(
     searches share and the full search gets whole; ``timeout`` the seconds for all of them.
     ``progress`` receives each search's statistics with ``stage``: ``"part k of N (P)"``
     while the agenda adds part P as the k-th of N (``"parts j-k of N (P+Q)"`` for a group,
-    :func:`parts_label`), ``"full search"`` after it failed.
+    :func:`parts_label`), ``"the relative goal"`` for the last search of a grounded relative
+    goal, ``"full search"`` after the agenda failed.
 
     The result's statistics add up every search of the run (``max_nodes`` is the run's limit);
     :attr:`~arrange_up.planning.planner.PlanResult.agenda` records the agenda. When the agenda
