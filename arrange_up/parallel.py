@@ -96,7 +96,6 @@ __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
     "WorkersLostError",
-    "local_workers_lost",
     "DaskRunner",
     "LocalRunner",
     "Pending",
@@ -108,6 +107,7 @@ __all__ = [
     "get_runner",
     "check_workers",
     "local_executor",
+    "local_workers_lost",
     "max_workers",
     "shutdown",
 ]

@@ -383,7 +383,7 @@ def plan_by_agenda(
         while sum(len(group) for group, _ in done) > position:
             done.pop()  # backtracking: the previous subgoal is searched again
     else:
-        if absolute is problem:
+        if grounding is None:
             return _joined(done, spent, _record(order, done, "agenda", expanded, None), max_nodes)
         # the relative goal itself, from the belief the grounded agenda reached
         nodes = max(0, min(per_part, max_nodes - expanded))
